@@ -1,0 +1,43 @@
+# Entry points. `make test` is the project's test command (README, .ci/run).
+SHELL := /bin/bash
+ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
+BUILD ?= $(ROOT)/build
+BUILD_ASAN ?= $(ROOT)/build-asan
+JOBS ?= $(shell nproc)
+# Debian's python (with catkin_pkg) must come before the pyenv shim.
+export PATH := /usr/bin:$(PATH)
+CMAKE_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
+  -DCATKIN_ENABLE_TESTING=ON
+
+.PHONY: deps build test test-asan bench clean
+
+deps:
+	@bash $(ROOT)/scripts/install_deps.sh
+
+$(BUILD)/CMakeCache.txt: | deps
+	@mkdir -p $(BUILD)
+	@cmake -S $(ROOT) -B $(BUILD) -DCATKIN_DEVEL_PREFIX=$(BUILD)/devel $(CMAKE_ARGS) >$(BUILD)/configure.log \
+	  || { cat $(BUILD)/configure.log; exit 1; }
+
+build: deps $(BUILD)/CMakeCache.txt
+	@cmake --build $(BUILD) -j$(JOBS) -- --no-print-directory
+
+## Every test (core gtests and rostests); ends with "N passed, N failed".
+test: build
+	@bash $(ROOT)/scripts/run_tests.sh $(BUILD)
+
+## The core tests under AddressSanitizer + UndefinedBehaviorSanitizer.
+test-asan: deps
+	@mkdir -p $(BUILD_ASAN)
+	@cmake -S $(ROOT) -B $(BUILD_ASAN) -DCATKIN_DEVEL_PREFIX=$(BUILD_ASAN)/devel $(CMAKE_ARGS) \
+	  -DWAVOG_SANITIZE="address;undefined" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWAVOG_BUILD_ROS=OFF \
+	  >$(BUILD_ASAN)/configure.log || { cat $(BUILD_ASAN)/configure.log; exit 1; }
+	@cmake --build $(BUILD_ASAN) -j$(JOBS) -- --no-print-directory
+	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  bash $(ROOT)/scripts/run_tests.sh $(BUILD_ASAN) -L core
+
+clean:
+	rm -rf $(BUILD) $(BUILD_ASAN)
+
+# Further targets (bench, demo, compare, ...) live in mk/*.mk, one file per part.
+-include $(ROOT)/mk/*.mk

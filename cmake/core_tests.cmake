@@ -1,0 +1,28 @@
+# Core unit tests: plain gtest executables registered with ctest, label "core". They need no ROS,
+# so they also run under the sanitizers (make test-asan).
+find_package(GTest REQUIRED)
+find_package(Threads REQUIRED)
+
+add_library(wavog_test_support STATIC test/core/dense_reference.cpp test/core/test_support.cpp)
+target_link_libraries(wavog_test_support PUBLIC wavog_core wavog_io GTest::GTest Threads::Threads)
+target_include_directories(wavog_test_support PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/test/core)
+target_compile_options(wavog_test_support PRIVATE ${WAVOG_WARNINGS})
+target_compile_definitions(wavog_test_support PUBLIC
+  WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}" EIGEN_INITIALIZE_MATRICES_BY_NAN)
+
+function(wavog_core_test name)
+  add_executable(${name} test/core/${name}.cpp)
+  target_link_libraries(${name} PRIVATE wavog_test_support GTest::Main)
+  target_compile_options(${name} PRIVATE ${WAVOG_WARNINGS})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_test(NAME core_${name} COMMAND ${name} --gtest_output=xml:${CMAKE_BINARY_DIR}/test_results/core/${name}.xml)
+  set_tests_properties(core_${name} PROPERTIES LABELS "core" TIMEOUT 900)
+endfunction()
+
+wavog_core_test(test_haar)
+wavog_core_test(test_params)
+wavog_core_test(test_reference_equivalence)
+wavog_core_test(test_lazy_forgetting)
+wavog_core_test(test_readout)
+wavog_core_test(test_map_io)
+wavog_core_test(test_carmen_reader)

@@ -1,0 +1,104 @@
+// Parameters of the core, as plain structs with defaults. validate() lists every violation;
+// the core constructors throw std::invalid_argument with that list, so an invalid map cannot exist.
+// Units: metres, radians, log-odds (natural log of P(occ)/P(emp)).
+#ifndef WAVOG_MAPPING_CORE_PARAMS_H_
+#define WAVOG_MAPPING_CORE_PARAMS_H_
+
+#include <string>
+#include <vector>
+
+namespace wavog {
+
+/// Update policy of a map (paper section 1.3). Names are the configuration strings.
+enum class PolicyType {
+  kNone,        ///< "none": additive Bayesian fusion, unbounded (eq. 1.2)
+  kMax,         ///< "max": odd_t = max(odd_{t-1}, odd(z)) (eq. 1.4)
+  kClamp,       ///< "clamp": additive, clamped to [clamp_min, clamp_max] (eq. 1.5)
+  kForget,      ///< "forget": exponential forgetting odd_t = (1-g) odd_{t-1} + g odd(z) (eq. 1.6)
+  kClampLower,  ///< "clamp_lower": additive, lower bound only (section 1.3.5)
+  kClampUpper,  ///< "clamp_upper": additive, upper bound only (section 1.3.5)
+};
+
+/// Value of never-observed cells (the map's prior).
+enum class InitValue {
+  kUnknown,     ///< "unknown": log-odds 0 (P = 0.5)
+  kEmptyBound,  ///< "empty_bound": the policy's empty bound (clamp_min, or odd_emp), best compression
+};
+
+/// Configuration name <-> enum. fromString returns false on an unknown name.
+const char* toString(PolicyType type);
+const char* toString(InitValue init);
+bool fromString(const std::string& name, PolicyType* type);
+bool fromString(const std::string& name, InitValue* init);
+
+/// Geometry of the grid.
+struct GridParams {
+  /// Finest cell size (m), in (0.001, 100].
+  double resolution = 0.05;
+  /// Levels of one hashed quadtree block: a block covers 2^block_levels cells per side, in [2, 12].
+  int block_levels = 9;
+};
+
+/// Three-valued inverse sensor model (ALGORITHM.md sections 3-4): E / O / U per cell.
+struct SensorModelParams {
+  /// Log-odds added (or, with forgetting, approached) in the occupied band, > 0.
+  double odd_occ = 3.5;
+  /// Log-odds added (or, with forgetting, approached) in free space, < 0.
+  double odd_emp = -2.0;
+  /// Width of the occupied band around a hit (m), >= 0; 0 means one cell (the resolution).
+  double band_width = 0.0;
+  /// Readings beyond this range (m) count as no return; 0 uses each scan's range_max; >= 0.
+  double max_range = 0.0;
+  /// No-return beams (+inf, >= range_max) clear free space up to this distance (m); 0: not at
+  /// all; >= 0.
+  double no_return_clear = 0.0;
+};
+
+/// Update policy and its parameters (paper section 1.3).
+struct PolicyParams {
+  /// The policy applied to E and O cells; U cells are never touched.
+  PolicyType type = PolicyType::kForget;
+  /// Forgetting rate gamma of eq. 1.6, in (0, 1]; used by "forget" only (paper: 0.3 at 10 Hz).
+  double gamma = 0.3;
+  /// Lower clamp bound (log-odds), < 0; used by "clamp" and "clamp_lower".
+  double clamp_min = -2.0;
+  /// Upper clamp bound (log-odds), > 0; used by "clamp" and "clamp_upper".
+  double clamp_max = 3.5;
+  /// Value of never-observed cells.
+  InitValue init = InitValue::kUnknown;
+};
+
+/// Everything a map needs.
+struct MapParams {
+  GridParams grid;
+  SensorModelParams sensor;
+  PolicyParams policy;
+  /// Detail threshold tau (log-odds) for online pruning, in [0, 1]. 0 is lossless up to float
+  /// round-off (details under 1e-6 are dropped); otherwise each cell's error from one pruning is
+  /// at most 1.25 * tau * block_levels (ALGORITHM.md section 2.4).
+  double prune_threshold = 0.0;
+  /// Forgetting only: a FREE_OR_UNKNOWN uniform block is left alone when the E update would move
+  /// it by at most this much (log-odds), in [0, 1]; 0 is exact. Error bound: skip_tolerance/gamma.
+  double skip_tolerance = 0.0;
+  /// Forgetting only: use lazy tags on fully-empty nodes (ALGORITHM.md section 6). false applies
+  /// the forgetting eagerly to every stored detail (slow; for benchmarks and tests).
+  bool lazy_forgetting = true;
+
+  /// Every violated rule, one line each, naming the parameter and its valid range. Empty: valid.
+  std::vector<std::string> validate() const;
+
+  /// The documented defaults for a policy: odd values, clamp bounds and gamma chosen for it.
+  /// "forget": odd_occ 3.5, odd_emp -2 (fixed points), gamma 0.3. Every other policy:
+  /// odd_occ 0.85, odd_emp -0.4 (OctoMap's 0.7 / 0.4), clamp [-2, 3.5].
+  static MapParams defaultsFor(PolicyType type);
+
+  /// Log-odds of a never-observed cell under these parameters.
+  double initValue() const;
+};
+
+/// Throws std::invalid_argument listing every violation of `params` (does nothing when valid).
+void throwIfInvalid(const MapParams& params);
+
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_CORE_PARAMS_H_

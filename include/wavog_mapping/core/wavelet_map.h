@@ -1,0 +1,128 @@
+// WaveletMap: the WavOG occupancy map. Log-odds stored as Haar-wavelet quadtree blocks (one
+// average per block, three details per node, a missing child is a uniform block) in a hash of
+// blocks, so it grows without bound in every direction. Scans are integrated coarse to fine with
+// the configured update policy; exponential forgetting uses lazy tags (ALGORITHM.md section 6).
+// Frames: everything is in the map frame; cell (ix, iy) covers [ix, ix+1) x [iy, iy+1) * resolution.
+// Thread-safety: none. Concurrent const calls are safe; any non-const call needs exclusive access.
+#ifndef WAVOG_MAPPING_CORE_WAVELET_MAP_H_
+#define WAVOG_MAPPING_CORE_WAVELET_MAP_H_
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "wavog_mapping/core/params.h"
+#include "wavog_mapping/core/types.h"
+
+namespace wavog {
+
+/// What one integrate() call did. Per-scan calls never throw: a refused scan has status != kOk.
+struct IntegrateStats {
+  ScanStatus status = ScanStatus::kOk;
+  std::uint32_t beams_hit = 0;        ///< beams with a return in [range_min, range_max)
+  std::uint32_t beams_no_return = 0;  ///< +inf or >= range_max (REP 117)
+  std::uint32_t beams_invalid = 0;    ///< NaN, -inf, <= 0, < range_min
+  std::uint64_t nodes_visited = 0;    ///< tree nodes and finest cells visited
+  std::uint32_t blocks_touched = 0;   ///< blocks classified as not U
+};
+
+/// Size and work figures of a map.
+struct MapStats {
+  std::size_t blocks = 0;           ///< hashed blocks
+  std::size_t nodes = 0;            ///< live quadtree nodes (each holds 3 details)
+  std::size_t bytes = 0;            ///< bytes held by blocks, nodes (allocated groups) and the hash
+  std::uint64_t nodes_visited_last = 0;  ///< nodes visited by the last integrate()
+  std::uint64_t observed_cells = 0;      ///< finest cells ever observed (only if requested)
+};
+
+/// How a coarse cell at scale s summarises its 4^s finest cells.
+enum class Aggregation {
+  kMean,  ///< the Haar average: mean log-odds of all finest cells (unobserved ones at the prior)
+  kMax,   ///< the maximum log-odds over the observed finest cells (conservative, for planners)
+};
+
+/// A dense raster of one window at one scale, row-major (row = y, x fastest).
+struct Raster {
+  int scale = 0;                  ///< cells are 2^scale finest cells wide
+  double cell_size = 0.0;         ///< metres per raster cell
+  CellBox box;                    ///< window, in scale-s cell units
+  std::vector<float> log_odds;    ///< per raster cell; the prior where nothing is observed
+  std::vector<std::uint8_t> known;  ///< 1 if any finest cell under it was ever observed
+  double originX() const { return static_cast<double>(box.min_x) * cell_size; }
+  double originY() const { return static_cast<double>(box.min_y) * cell_size; }
+};
+
+/// OccupancyGrid value of a log-odds: round(100 * P(occ)), in 0..100.
+std::int8_t occupancyFromLogOdds(float log_odds);
+/// OccupancyGrid values of a raster, same order: -1 where unknown, else occupancyFromLogOdds.
+std::vector<std::int8_t> toOccupancyGrid(const Raster& raster);
+
+/// A map file could not be written or read. what() names the file and the reason.
+class MapIoError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class WaveletMap {
+ public:
+  /// Throws std::invalid_argument naming every invalid parameter.
+  explicit WaveletMap(const MapParams& params);
+  ~WaveletMap();
+  WaveletMap(WaveletMap&&) noexcept;
+  WaveletMap& operator=(WaveletMap&&) noexcept;
+  WaveletMap(const WaveletMap&) = delete;
+  WaveletMap& operator=(const WaveletMap&) = delete;
+
+  const MapParams& params() const;
+  double resolution() const;
+
+  /// Integrates one scan taken from `sensor_pose` (map frame). Beams are classified per REP 117;
+  /// every cell in the field of view is updated at most once. Never throws.
+  IntegrateStats integrate(const Pose2& sensor_pose, const ScanView& scan);
+
+  /// Changes policy and sensor-model parameters at run time (grid and pruning stay). Pending lazy
+  /// forgetting is applied first, so the stored map stays exact. Throws std::invalid_argument.
+  void setPolicy(const PolicyParams& policy, const SensorModelParams& sensor);
+
+  /// Log-odds of one finest cell (the prior if never observed) and whether it was observed.
+  float value(const CellIndex& cell) const;
+  bool isObserved(const CellIndex& cell) const;
+  /// Finest cell containing a map-frame point.
+  CellIndex cellAt(double x, double y) const;
+
+  /// Smallest box of scale-s cells holding every stored block; false when the map is empty.
+  bool bounds(int scale, CellBox* box) const;
+  /// Box of scale-s cells covering the metric rectangle [min, max] (map frame).
+  CellBox boxAround(double min_x, double min_y, double max_x, double max_y, int scale) const;
+  /// Dense read-out of `window` at scale s in [0, block_levels]. Cost follows the stored nodes
+  /// inside the window, not the whole map.
+  Raster exportScale(int scale, const CellBox& window, Aggregation aggregation) const;
+
+  /// Forgets everything: the whole map back to never observed.
+  void reset();
+  /// Every finest cell whose centre lies in [min_x, max_x] x [min_y, max_y] (map frame) goes back
+  /// to never observed.
+  void clearBox(double min_x, double min_y, double max_x, double max_y);
+
+  /// Writes the map (versioned binary, CRC-32 checked) to `path` through a temporary file and a
+  /// rename, so a crash never leaves a half-written map. Throws MapIoError.
+  void save(const std::string& path) const;
+  /// Replaces the map by the one in `path`. A missing, truncated, corrupted or foreign file, or one
+  /// with another resolution or block size, throws MapIoError and leaves this map unchanged.
+  void load(const std::string& path);
+
+  /// Counts; `count_observed` also walks the tree to count observed cells (O(nodes)).
+  MapStats stats(bool count_observed = false) const;
+
+ private:
+  friend class ScanIntegrator;
+  friend struct MapAccess;  // tests and benchmarks inspect internals through this
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_CORE_WAVELET_MAP_H_

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs what wavog_mapping needs from Debian 12's archive. Idempotent: when every package is
+# already installed it returns in well under a second without touching the network.
+set -euo pipefail
+
+PKGS=(
+  build-essential cmake pkg-config zlib1g-dev libeigen3-dev libgtest-dev libgmock-dev
+  libbenchmark-dev libpng-dev liboctomap-dev
+  ros-base-dev catkin libroscpp-dev libnodelet-dev pluginlib-dev
+  libtf2-ros-dev libtf2-eigen-dev liblaser-geometry-dev libdiagnostic-updater-dev
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  libsensor-msgs-dev libnav-msgs-dev libstd-srvs-dev libmap-msgs-dev libgeometry-msgs-dev
+  librosbag-dev librosbag-storage-dev python3-rosbag python3-rostest python3-roslaunch
+  python3-rosmaster python3-rostopic python3-rosnode python3-tf2-ros python3-rosgraph rosout
+  python3-catkin-pkg python3-genmsg python3-gencpp python3-genpy
+  ros-message-generation ros-message-runtime
+)
+
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install_deps: missing packages (${missing[*]}); run as root or install them" >&2
+  exit 1
+fi
+echo "install_deps: installing ${#missing[@]} package(s): ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
