@@ -25,10 +25,14 @@ struct CarmenScan {
                             ///< ROBOTLASER1
   double angle_min = 0.0;   ///< bearing of the first beam in the laser frame (rad)
   double angle_increment = 0.0;  ///< bearing step (rad)
-  double range_max = 0.0;   ///< readings at or above are no return (m)
-  std::vector<float> ranges;  ///< as logged (sentinels >= ~80 m stay as logged; see noReturn())
+  double range_max = 0.0;   ///< readings at or above are no return (m), at most kNoReturnRange
+  /// Ranges as logged (m). The no-return sentinels (81.91, ...) stay as logged: they are >=
+  /// range_max, which is "no return" per REP 117 (see isNoReturn()).
+  std::vector<float> ranges;
   /// A view for WaveletMap::integrate (valid while this object lives and is unchanged).
   ScanView view(double range_min = 0.0) const;
+  /// True if beam reading `r` means "no return" for this scan (r >= range_max or +inf).
+  bool isNoReturn(float r) const { return !(r < range_max) && r == r; }
 };
 
 /// A line could not be parsed; what() is "<file>:<line>: <reason>".
@@ -52,11 +56,16 @@ class CarmenReader {
   CarmenReader& operator=(const CarmenReader&) = delete;
 
   /// Reads the next laser scan; false at the end of the log. Lines of other types are skipped.
-  /// A truncated gzip stream throws std::runtime_error naming the file.
+  /// A truncated or corrupted gzip stream throws std::runtime_error naming the file.
   bool next(CarmenScan* scan);
 
   /// Messages of the malformed lines skipped so far (non-strict mode), "<file>:<line>: <reason>".
   const std::vector<std::string>& errors() const;
+
+  /// True if the file is gzip-compressed (detected from its first two bytes).
+  bool compressed() const;
+  /// Lines read so far (all types, comments included).
+  std::size_t linesRead() const;
 
   /// Range of the CARMEN "no return" sentinels: readings at or above it are no return (m).
   static constexpr double kNoReturnRange = 80.0;
