@@ -12,7 +12,7 @@ PKGS=(
   libsensor-msgs-dev libnav-msgs-dev libstd-srvs-dev libmap-msgs-dev libgeometry-msgs-dev
   librosbag-dev librosbag-storage-dev python3-rosbag python3-rostest python3-roslaunch
   python3-rosmaster python3-rostopic python3-rosnode python3-tf2-ros python3-rosgraph rosout
-  python3-catkin-pkg python3-genmsg python3-gencpp python3-genpy
+  python3-catkin-pkg python3-genmsg python3-gencpp python3-genpy libyaml-cpp-dev
   ros-message-generation ros-message-runtime
 )
 

@@ -1,0 +1,100 @@
+// The one parameter loader of the package: the nodelet, the node and the offline tools all read
+// their configuration through configFromXmlRpc(), from the ROS parameter server (loadConfig) or
+// from a YAML file (loadConfigFile). Units: metres, seconds, hertz, log-odds. Thread-safety: the
+// functions are reentrant; Config is a plain value.
+#ifndef WAVOG_MAPPING_ROS_CONFIG_H_
+#define WAVOG_MAPPING_ROS_CONFIG_H_
+
+#include <string>
+#include <vector>
+
+#include <ros/node_handle.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include "wavog_mapping/core/params.h"
+#include "wavog_mapping/core/wavelet_map.h"
+
+namespace wavog_ros {
+
+/// Most LaserScan inputs one mapper accepts.
+constexpr int kMaxInputs = 4;
+
+/// One LaserScan input.
+struct InputConfig {
+  /// Topic name, resolved in the node's namespace (relative names are remappable).
+  std::string topic;
+  /// Expected publication rate (Hz) for the diagnostics, in [0, 1000]; 0 disables the rate check.
+  double expected_rate = 0.0;
+};
+
+/// Parameters of the ROS layer (the core's are in wavog::MapParams).
+struct RosParams {
+  /// Fixed frame of the map and of the published grids.
+  std::string map_frame = "map";
+  /// Robot frame; the centre of publish_window.
+  std::string base_frame = "base_link";
+  /// 1 to 4 LaserScan inputs.
+  std::vector<InputConfig> inputs = {{"scan", 0.0}};
+  /// Rate (Hz) of the full publication of every layer and of the status, in (0, 100].
+  double publish_rate = 1.0;
+  /// Scales s published as map_scale_<s> (cells 2^s times the resolution), each in
+  /// [1, block_levels], distinct; may be empty.
+  std::vector<int> publish_scales = {2, 3, 4};
+  /// How a coarse cell summarises its finest cells.
+  wavog::Aggregation scale_aggregation = wavog::Aggregation::kMean;
+  /// Half-width (m) of the square around base_frame that is published, >= 0; 0: the whole map.
+  double publish_window = 0.0;
+  /// Rate (Hz) of map_updates (changed rectangle of the finest layer), in [0, 100]; 0: off.
+  double update_rate = 0.0;
+  /// A scan waits in the tf2 MessageFilter until tf is known up to stamp + this (s), in [0, 1].
+  /// Motion compensation needs it >= the sweep duration (LMS-291: 13-27 ms).
+  double tf_tolerance = 0.03;
+  /// Length (s) of the tf buffer, in [1, 3600]; scans older than this cannot be placed.
+  double tf_cache_time = 30.0;
+  /// Scans per input waiting for tf in the MessageFilter, in [1, 1000].
+  int queue_size = 20;
+  /// Place each beam with the sensor pose interpolated over the sweep (needs time_increment).
+  bool motion_compensation = true;
+  /// Native map file loaded at start-up; empty: start with an empty map.
+  std::string map_file;
+  /// Relative tolerance of the diagnostics' rate check, in [0, 1).
+  double rate_tolerance = 0.5;
+};
+
+/// Everything the mapper reads.
+struct Config {
+  wavog::MapParams map;
+  RosParams ros;
+};
+
+/// Every top-level key the loader knows, in documentation order.
+const std::vector<std::string>& knownKeys();
+
+/// The one loader. Starts from MapParams::defaultsFor(policy) (policy from `root`, default
+/// "forget") and RosParams{}, overrides with the keys of `root` (an XmlRpc struct; an invalid
+/// value of any other type is treated as empty), then validates. Keys it does not know are
+/// appended to *unknown_keys (if not null) and otherwise ignored. Throws std::invalid_argument
+/// whose message names each bad parameter, its value and its valid range.
+Config configFromXmlRpc(XmlRpc::XmlRpcValue& root, std::vector<std::string>* unknown_keys);
+
+/// Reads the private namespace of `pnh` as one struct and calls configFromXmlRpc.
+Config loadConfig(const ros::NodeHandle& pnh, std::vector<std::string>* unknown_keys);
+
+/// Parses a YAML file (a map of the keys above) and calls configFromXmlRpc. Throws
+/// std::invalid_argument (also for an unreadable or malformed file, naming it).
+Config loadConfigFile(const std::string& yaml_path, std::vector<std::string>* unknown_keys);
+
+/// Converts YAML text to XmlRpc (maps, sequences, bool, int, double, string). Throws
+/// std::invalid_argument on malformed YAML.
+XmlRpc::XmlRpcValue yamlToXmlRpc(const std::string& yaml_text);
+
+/// Aggregation <-> configuration name ("mean", "max").
+const char* toString(wavog::Aggregation aggregation);
+bool fromString(const std::string& name, wavog::Aggregation* aggregation);
+
+/// Every violation of the ROS parameters (given the core parameters), one line each.
+std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& map);
+
+}  // namespace wavog_ros
+
+#endif  // WAVOG_MAPPING_ROS_CONFIG_H_

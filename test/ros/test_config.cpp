@@ -1,0 +1,177 @@
+// The one parameter loader: shipped files load and validate, default.yaml equals the compiled
+// defaults key by key, unknown keys are reported, bad values name the parameter and its range.
+#include <gtest/gtest.h>
+
+#include <dirent.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "wavog_mapping/ros/config.h"
+
+namespace wavog_ros {
+namespace {
+
+const std::string kConfigDir = std::string(WAVOG_SOURCE_DIR) + "/config";
+
+Config fromYaml(const std::string& text, std::vector<std::string>* unknown = nullptr) {
+  XmlRpc::XmlRpcValue root = yamlToXmlRpc(text);
+  return configFromXmlRpc(root, unknown);
+}
+
+std::string errorOf(const std::string& text) {
+  try {
+    fromYaml(text);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expectSame(const Config& a, const Config& b) {
+  EXPECT_EQ(a.map.grid.resolution, b.map.grid.resolution);
+  EXPECT_EQ(a.map.grid.block_levels, b.map.grid.block_levels);
+  EXPECT_EQ(a.map.policy.type, b.map.policy.type);
+  EXPECT_EQ(a.map.policy.gamma, b.map.policy.gamma);
+  EXPECT_EQ(a.map.policy.clamp_min, b.map.policy.clamp_min);
+  EXPECT_EQ(a.map.policy.clamp_max, b.map.policy.clamp_max);
+  EXPECT_EQ(a.map.policy.init, b.map.policy.init);
+  EXPECT_EQ(a.map.sensor.odd_occ, b.map.sensor.odd_occ);
+  EXPECT_EQ(a.map.sensor.odd_emp, b.map.sensor.odd_emp);
+  EXPECT_EQ(a.map.sensor.band_width, b.map.sensor.band_width);
+  EXPECT_EQ(a.map.sensor.max_range, b.map.sensor.max_range);
+  EXPECT_EQ(a.map.sensor.no_return_clear, b.map.sensor.no_return_clear);
+  EXPECT_EQ(a.map.prune_threshold, b.map.prune_threshold);
+  EXPECT_EQ(a.map.skip_tolerance, b.map.skip_tolerance);
+  EXPECT_EQ(a.map.lazy_forgetting, b.map.lazy_forgetting);
+  EXPECT_EQ(a.ros.map_frame, b.ros.map_frame);
+  EXPECT_EQ(a.ros.base_frame, b.ros.base_frame);
+  ASSERT_EQ(a.ros.inputs.size(), b.ros.inputs.size());
+  for (std::size_t i = 0; i < a.ros.inputs.size(); ++i) {
+    EXPECT_EQ(a.ros.inputs[i].topic, b.ros.inputs[i].topic);
+    EXPECT_EQ(a.ros.inputs[i].expected_rate, b.ros.inputs[i].expected_rate);
+  }
+  EXPECT_EQ(a.ros.publish_rate, b.ros.publish_rate);
+  EXPECT_EQ(a.ros.publish_scales, b.ros.publish_scales);
+  EXPECT_EQ(a.ros.scale_aggregation, b.ros.scale_aggregation);
+  EXPECT_EQ(a.ros.publish_window, b.ros.publish_window);
+  EXPECT_EQ(a.ros.update_rate, b.ros.update_rate);
+  EXPECT_EQ(a.ros.tf_tolerance, b.ros.tf_tolerance);
+  EXPECT_EQ(a.ros.tf_cache_time, b.ros.tf_cache_time);
+  EXPECT_EQ(a.ros.queue_size, b.ros.queue_size);
+  EXPECT_EQ(a.ros.motion_compensation, b.ros.motion_compensation);
+  EXPECT_EQ(a.ros.map_file, b.ros.map_file);
+  EXPECT_EQ(a.ros.rate_tolerance, b.ros.rate_tolerance);
+}
+
+TEST(Config, DefaultYamlEqualsCompiledDefaults) {
+  std::vector<std::string> unknown;
+  const Config file = loadConfigFile(kConfigDir + "/default.yaml", &unknown);
+  EXPECT_TRUE(unknown.empty());
+  XmlRpc::XmlRpcValue empty;
+  expectSame(file, configFromXmlRpc(empty, nullptr));
+  // The compiled defaults are the "forget" policy's.
+  const wavog::MapParams forget = wavog::MapParams::defaultsFor(wavog::PolicyType::kForget);
+  EXPECT_EQ(file.map.sensor.odd_occ, forget.sensor.odd_occ);
+  EXPECT_EQ(file.map.policy.gamma, forget.policy.gamma);
+}
+
+TEST(Config, DefaultYamlListsEveryKnownKey) {
+  std::ifstream in(kConfigDir + "/default.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  XmlRpc::XmlRpcValue file = yamlToXmlRpc(text.str());
+  std::set<std::string> in_file;
+  for (auto& member : file) in_file.insert(member.first);
+  const std::set<std::string> known(knownKeys().begin(), knownKeys().end());
+  EXPECT_EQ(in_file, known);
+}
+
+TEST(Config, EveryShippedFileLoads) {
+  DIR* dir = opendir(kConfigDir.c_str());
+  ASSERT_NE(dir, nullptr);
+  int files = 0;
+  while (dirent* entry = readdir(dir)) {
+    const std::string name = entry->d_name;
+    if (name.size() < 5 || name.substr(name.size() - 5) != ".yaml") continue;
+    std::vector<std::string> unknown;
+    EXPECT_NO_THROW(loadConfigFile(kConfigDir + "/" + name, &unknown)) << name;
+    EXPECT_TRUE(unknown.empty()) << name << ": unknown key " << unknown.front();
+    ++files;
+  }
+  closedir(dir);
+  EXPECT_GE(files, 2);
+}
+
+TEST(Config, PolicySelectsItsDefaults) {
+  const Config c = fromYaml("policy: clamp");
+  const wavog::MapParams d = wavog::MapParams::defaultsFor(wavog::PolicyType::kClamp);
+  EXPECT_EQ(c.map.policy.type, wavog::PolicyType::kClamp);
+  EXPECT_EQ(c.map.sensor.odd_occ, d.sensor.odd_occ);
+  EXPECT_EQ(c.map.sensor.odd_emp, d.sensor.odd_emp);
+  // An explicit key still wins over the policy default.
+  EXPECT_EQ(fromYaml("{policy: clamp, odd_occ: 1.5}").map.sensor.odd_occ, 1.5);
+}
+
+TEST(Config, ReadsInputsAndLists) {
+  const Config c = fromYaml(R"(
+inputs: [{topic: a, expected_rate: 37.5}, b]
+publish_scales: [1, 5]
+scale_aggregation: max
+resolution: 1
+)");
+  ASSERT_EQ(c.ros.inputs.size(), 2u);
+  EXPECT_EQ(c.ros.inputs[0].topic, "a");
+  EXPECT_EQ(c.ros.inputs[0].expected_rate, 37.5);
+  EXPECT_EQ(c.ros.inputs[1].topic, "b");
+  EXPECT_EQ(c.ros.publish_scales, (std::vector<int>{1, 5}));
+  EXPECT_EQ(c.ros.scale_aggregation, wavog::Aggregation::kMax);
+  EXPECT_EQ(c.map.grid.resolution, 1.0);  // an int is accepted for a double
+}
+
+TEST(Config, ReportsUnknownKeys) {
+  std::vector<std::string> unknown;
+  fromYaml("{resolutoin: 0.1, publish_rate: 2}", &unknown);
+  ASSERT_EQ(unknown.size(), 1u);
+  EXPECT_EQ(unknown[0], "resolutoin");
+}
+
+TEST(Config, BadValuesNameTheParameterAndItsRange) {
+  EXPECT_NE(errorOf("resolution: -1").find("resolution"), std::string::npos);
+  EXPECT_NE(errorOf("publish_rate: 0").find("publish_rate (0) must be in (0, 100]"),
+            std::string::npos);
+  EXPECT_NE(errorOf("publish_scales: [0]").find("publish_scales"), std::string::npos);
+  EXPECT_NE(errorOf("publish_scales: [12]").find("block_levels"), std::string::npos);
+  EXPECT_NE(errorOf("inputs: []").find("1 to 4"), std::string::npos);
+  EXPECT_NE(errorOf("inputs: [a, b, c, d, e]").find("1 to 4"), std::string::npos);
+  EXPECT_NE(errorOf("inputs: [a, a]").find("twice"), std::string::npos);
+  EXPECT_NE(errorOf("queue_size: 0").find("queue_size (0) must be in [1, 1000]"),
+            std::string::npos);
+  EXPECT_NE(errorOf("tf_tolerance: 2").find("tf_tolerance"), std::string::npos);
+  EXPECT_NE(errorOf("map_frame: /map").find("map_frame"), std::string::npos);
+  EXPECT_NE(errorOf("policy: forgetful").find("policy"), std::string::npos);
+  EXPECT_NE(errorOf("scale_aggregation: median").find("mean, max"), std::string::npos);
+  EXPECT_NE(errorOf("resolution: abc").find("'resolution'"), std::string::npos);
+  EXPECT_NE(errorOf("queue_size: 2.5").find("integer"), std::string::npos);
+  EXPECT_NE(errorOf("motion_compensation: 1").find("true or false"), std::string::npos);
+  EXPECT_NE(errorOf("gamma: 0").find("gamma"), std::string::npos);
+  EXPECT_NE(errorOf("inputs: [{topic: a, rate: 3}]").find("unknown key 'rate'"),
+            std::string::npos);
+}
+
+TEST(Config, MissingOrMalformedFileIsAClearError) {
+  try {
+    loadConfigFile("/nonexistent/x.yaml", nullptr);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/x.yaml"), std::string::npos);
+  }
+  EXPECT_THROW(yamlToXmlRpc("a: [1, 2"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace wavog_ros
