@@ -1,0 +1,45 @@
+// Motion compensation of one planar sweep: beams measured while the sensor moved are re-expressed
+// in one reference pose and re-binned onto the scan's angular grid, so that the result can go to
+// WaveletMap::integrate(reference, view). Map frame, metres, radians. Not thread-safe (one
+// compensator per thread; it reuses its buffer).
+#ifndef WAVOG_MAPPING_CORE_MOTION_COMPENSATION_H_
+#define WAVOG_MAPPING_CORE_MOTION_COMPENSATION_H_
+
+#include <cstddef>
+#include <vector>
+
+#include "wavog_mapping/core/types.h"
+
+namespace wavog {
+
+/// Pose at fraction f of the way from a (f = 0) to b (f = 1): linear in position, along the
+/// shorter arc in heading.
+Pose2 interpolate(const Pose2& a, const Pose2& b, double f);
+
+/// Re-bins moving-sensor scans. Beam i is assumed to be measured at fraction i / (count - 1) of the
+/// sweep (uniform time_increment), from the pose interpolated between `start` (beam 0) and `end`
+/// (last beam).
+class MotionCompensator {
+ public:
+  /// Returns the scan as seen from `reference`: same angle_min, angle_increment, count and range
+  /// limits; bin j holds the nearest return whose endpoint lies in its bearing cell. Without a
+  /// return, a bin keeps a "no return" value (+inf or >= range_max, as measured, rotated into the
+  /// reference frame), else an invalid value as measured (REP 117), else NaN (no information).
+  /// Returns land outside the field of view are dropped (counted by droppedLast()); a full-circle
+  /// scan wraps around. The view points into this object and stays valid until the next call.
+  /// A scan without beams or with a zero or non-finite angle_increment is returned unchanged.
+  ScanView compensate(const ScanView& scan, const Pose2& start, const Pose2& end,
+                      const Pose2& reference);
+
+  /// Returns dropped by the last compensate() because they left the field of view.
+  std::size_t droppedLast() const { return dropped_; }
+
+ private:
+  std::vector<float> ranges_;
+  std::vector<signed char> rank_;  // per bin: -1 empty, 0 invalid, 1 no return, 2 return
+  std::size_t dropped_ = 0;
+};
+
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_CORE_MOTION_COMPENSATION_H_
