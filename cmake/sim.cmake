@@ -1,0 +1,23 @@
+# Simulation, scenario and policy evaluation (issue 5): wavog_sim (ROS-free: std + Eigen +
+# yaml-cpp), wavog_simulate (rosbag writer), wavog_evaluate, and their gtests (ctest label "sim").
+find_package(yaml-cpp REQUIRED)
+find_package(GTest REQUIRED)
+
+add_library(wavog_sim
+  src/sim/geometry.cpp src/sim/world.cpp src/sim/world_file.cpp src/sim/laser_sim.cpp
+  src/sim/ground_truth.cpp)
+target_link_libraries(wavog_sim PUBLIC wavog_core PRIVATE yaml-cpp)
+target_compile_options(wavog_sim PRIVATE ${WAVOG_WARNINGS})
+set_target_properties(wavog_sim PROPERTIES POSITION_INDEPENDENT_CODE ON)
+
+function(wavog_sim_test name)
+  add_executable(${name} test/sim/${name}.cpp)
+  target_link_libraries(${name} PRIVATE ${ARGN} GTest::GTest GTest::Main)
+  target_compile_options(${name} PRIVATE ${WAVOG_WARNINGS})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_test(NAME sim_${name} COMMAND ${name}
+           --gtest_output=xml:${CMAKE_BINARY_DIR}/test_results/sim/${name}.xml)
+  set_tests_properties(sim_${name} PROPERTIES LABELS "sim" TIMEOUT 300)
+endfunction()
+
+wavog_sim_test(test_simulator wavog_sim)

@@ -1,0 +1,41 @@
+// World files: a scenario as YAML or JSON (JSON is read as YAML flow style). Layout:
+//   name: car_park            duration: 60          region: [xmin, ymin, xmax, ymax]
+//   objects:                  # kind: wall|car|pedestrian|obstacle, role: static|moving|departing|arriving
+//     - {name: w, kind: wall, polygon: [[x, y], ...]}                       # world frame
+//     - {name: c, kind: car, role: departing, box: [length, width],         # or polygon (object frame)
+//        trajectory: [[t, x, y, theta_deg], ...], appear: t0, disappear: t1}
+//     - {name: p, kind: pedestrian, circle: [radius, sides], route: {speed: 1, start: 2, points: [[x, y], ...]}}
+//   vehicle: {box: [8, 2.5], trajectory: [...] or route: {...}, lasers: [...]}
+//   lasers: {name, frame_id, topic, x, y, yaw_deg, beams, fov_deg, range_min, range_max, rate_hz,
+//            phase_s, noise_sigma, dropout_prob}; or {corner: front_left, ...} for an LMS-291 at a
+//            corner of the vehicle box. Angles in files are in degrees.
+#ifndef WAVOG_MAPPING_SIM_WORLD_FILE_H_
+#define WAVOG_MAPPING_SIM_WORLD_FILE_H_
+
+#include <stdexcept>
+#include <string>
+
+#include "wavog_mapping/sim/world.h"
+
+namespace wavog {
+namespace sim {
+
+/// A world file could not be read; what() names the file, the entry and the reason.
+class WorldFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Reads a world from YAML or JSON text; `origin` names the source in error messages.
+/// Throws WorldFileError on a syntax error, an unknown key, a bad value or an invalid world.
+World parseWorld(const std::string& text, const std::string& origin = "<string>");
+/// Reads a world file (YAML or JSON). Throws WorldFileError.
+World loadWorld(const std::string& path);
+/// The world as YAML that parseWorld reads back to the same world (polygons and waypoints
+/// explicit, angles in degrees printed with full precision).
+std::string worldToYaml(const World& world);
+
+}  // namespace sim
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_SIM_WORLD_FILE_H_
