@@ -20,7 +20,7 @@ set_tests_properties(baseline_test_dense_grid PROPERTIES LABELS "baseline" TIMEO
 
 # ---- wavog_compare: the benchmark program (needs Debian's liboctomap-dev) -----------------------
 find_package(octomap QUIET)
-if(octomap_FOUND AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/tools/compare.cpp)
+if(octomap_FOUND)
   add_executable(wavog_compare src/tools/compare.cpp)
   target_link_libraries(wavog_compare PRIVATE wavog_core wavog_io wavog_baseline ${OCTOMAP_LIBRARIES})
   target_include_directories(wavog_compare SYSTEM PRIVATE ${OCTOMAP_INCLUDE_DIRS})
