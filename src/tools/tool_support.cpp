@@ -1,0 +1,243 @@
+#include "tool_support.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "wavog_mapping/io/carmen_reader.h"
+
+namespace wavog_tools {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRedrawSeconds = 0.1;
+constexpr int kBarWidth = 30;
+
+std::string formatDuration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+  const long s = std::lround(seconds);
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%02ld:%02ld", s / 60, s % 60);
+  return buf;
+}
+
+}  // namespace
+
+wavog::Pose2 compose(const wavog::Pose2& a, const wavog::Pose2& b) {
+  const double c = std::cos(a.theta);
+  const double s = std::sin(a.theta);
+  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrapAngle(a.theta + b.theta)};
+}
+
+wavog::Pose2 inverse(const wavog::Pose2& a) {
+  const double c = std::cos(a.theta);
+  const double s = std::sin(a.theta);
+  return {-c * a.x - s * a.y, s * a.x - c * a.y, wrapAngle(-a.theta)};
+}
+
+double wrapAngle(double a) {
+  a = std::remainder(a, 2.0 * kPi);
+  return a <= -kPi ? a + 2.0 * kPi : a;
+}
+
+const CarmenLaser* CarmenLogPlan::laserFor(const std::string& type) const {
+  for (const auto& laser : lasers) {
+    if (laser.type == type) return laser.used ? &laser : nullptr;
+  }
+  return nullptr;
+}
+
+CarmenLogPlan planCarmenLog(const std::string& path) {
+  CarmenLogPlan plan;
+  wavog::CarmenReader reader(path, false);
+  wavog::CarmenScan scan;
+  try {
+    while (reader.next(&scan)) {
+      auto it = std::find_if(plan.lasers.begin(), plan.lasers.end(),
+                             [&](const CarmenLaser& l) { return l.type == scan.type; });
+      if (it == plan.lasers.end()) {
+        CarmenLaser laser;
+        laser.type = scan.type;
+        laser.frame = scan.type == "RLASER" ? "rear_laser" : "front_laser";
+        laser.topic = "/" + laser.frame + "/scan";
+        const wavog::Pose2 mount = compose(inverse(scan.robot_pose), scan.laser_pose);
+        if (std::hypot(mount.x, mount.y) <= kMaxMountOffset) {
+          laser.mount = mount;
+          laser.mount_from_log = true;
+        }
+        plan.lasers.push_back(laser);
+        it = plan.lasers.end() - 1;
+      }
+      ++it->scans;
+    }
+  } catch (const std::runtime_error& e) {
+    plan.read_error = e.what();  // met again, at its place, by the second pass
+  }
+  const bool has_flaser = plan.laserFor("FLASER") != nullptr;
+  for (auto& laser : plan.lasers) {
+    if (laser.type == "ROBOTLASER1" && has_flaser) {
+      laser.used = false;
+      plan.skipped_duplicates += laser.scans;
+    }
+    if (laser.used) plan.scans_used += laser.scans;
+  }
+  return plan;
+}
+
+double StampRepair::repair(double raw) {
+  double t = 0.0;
+  if (!std::isfinite(raw) || raw <= 0.0) {
+    t = have_last_ ? last_ + period_ : epoch_;
+    ++synthesised_;
+  } else {
+    if (!offset_known_) {
+      offset_ = raw < kRelativeLimit ? epoch_ : 0.0;
+      offset_known_ = true;
+    }
+    if (offset_ != 0.0) ++shifted_;
+    t = raw + offset_;
+  }
+  // Logs print microseconds: keep exactly those (a double near 1e9 s resolves ~0.2 us).
+  t = std::round(t * 1e6) / 1e6;
+  if (have_last_ && !(t > last_)) {
+    largest_back_ = std::max(largest_back_, last_ - t);
+    t = last_ + kMinStep;
+    ++clamped_;
+  }
+  last_ = t;
+  have_last_ = true;
+  return t;
+}
+
+std::vector<std::string> StampRepair::report() const {
+  std::vector<std::string> lines;
+  if (shifted_ > 0) {
+    std::ostringstream s;
+    s << shifted_ << " relative time stamps shifted by " << std::fixed << std::setprecision(0)
+      << offset_ << " s (--epoch)";
+    lines.push_back(s.str());
+  }
+  if (clamped_ > 0) {
+    std::ostringstream s;
+    s << clamped_ << " time stamps not after the previous one clamped to previous + 1 us "
+      << "(largest backward step " << largest_back_ << " s)";
+    lines.push_back(s.str());
+  }
+  if (synthesised_ > 0) {
+    std::ostringstream s;
+    s << synthesised_ << " missing (zero) time stamps synthesised at " << 1.0 / period_
+      << " Hz (--rate)";
+    lines.push_back(s.str());
+  }
+  return lines;
+}
+
+void toSecNsec(double stamp, std::uint32_t* sec, std::uint32_t* nsec) {
+  double whole = std::floor(stamp);
+  long long usec = std::llround((stamp - whole) * 1e6);
+  if (usec >= 1000000) {
+    whole += 1.0;
+    usec -= 1000000;
+  }
+  *sec = static_cast<std::uint32_t>(whole);
+  *nsec = static_cast<std::uint32_t>(usec * 1000);
+}
+
+ProgressBar::ProgressBar(std::size_t total, bool enabled)
+    : total_(total),
+      enabled_(enabled),
+      tty_(isatty(STDERR_FILENO) != 0),
+      start_(std::chrono::steady_clock::now()),
+      last_draw_(start_) {}
+
+void ProgressBar::update(std::size_t done) {
+  if (!enabled_) return;
+  if (tty_) {
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - last_draw_).count() < kRedrawSeconds) return;
+    last_draw_ = now;
+    draw(done, false);
+  } else if (total_ > 0 && done * 10 >= next_decile_ * total_ && next_decile_ < 10) {
+    while (next_decile_ < 10 && done * 10 >= next_decile_ * total_) ++next_decile_;
+    draw(done, false);
+  }
+}
+
+void ProgressBar::finish(std::size_t done) {
+  if (enabled_) draw(done, true);
+}
+
+void ProgressBar::draw(std::size_t done, bool final_line) {
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;
+  const double eta = rate > 0 && total_ >= done ? static_cast<double>(total_ - done) / rate : -1;
+  const double fraction =
+      total_ > 0 ? std::min(1.0, static_cast<double>(done) / static_cast<double>(total_)) : 1.0;
+  std::ostringstream s;
+  if (tty_) {
+    const int filled = static_cast<int>(fraction * kBarWidth);
+    s << "\r[" << std::string(static_cast<std::size_t>(filled), '#')
+      << std::string(static_cast<std::size_t>(kBarWidth - filled), ' ') << "] ";
+  }
+  s << done << "/" << total_ << " scans " << std::fixed << std::setprecision(0) << rate
+    << " scans/s ";
+  if (final_line) {
+    s << "in " << std::setprecision(2) << elapsed << " s";
+  } else {
+    s << "ETA " << formatDuration(eta);
+  }
+  s << (tty_ && !final_line ? "   " : "\n");
+  std::fputs(s.str().c_str(), stderr);
+  std::fflush(stderr);
+}
+
+std::string jsonString(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(c));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string jsonNumber(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream s;
+  s << std::setprecision(10) << v;
+  return s.str();
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, ',')) {
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+std::string stripSlash(const std::string& frame) {
+  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
+}
+
+}  // namespace wavog_tools
