@@ -140,5 +140,20 @@ TEST(MotionCompensation, DegenerateScansPassThrough) {
   EXPECT_EQ(mc.compensate(empty, Pose2{}, Pose2{1, 0, 0}, Pose2{}).count, 0u);
 }
 
+TEST(MotionCompensation, ScanReachFollowsTheLongestReturn) {
+  std::vector<float> ranges = {1.0f, 7.5f, kNan, kInf, 90.0f};
+  SensorModelParams sensor;
+  const ScanView v = viewOf(ranges, 0.0, 0.1);
+  EXPECT_NEAR(scanReach(v, sensor, 0.1), 7.5 + 0.2, 1e-9);
+  sensor.no_return_clear = 20.0;
+  EXPECT_NEAR(scanReach(v, sensor, 0.1), 20.0 + 0.2, 1e-9);
+  sensor.max_range = 5.0;  // 7.5 m is now a no-return beam
+  sensor.no_return_clear = 0.0;
+  EXPECT_NEAR(scanReach(v, sensor, 0.1), 1.0 + 0.2, 1e-9);
+  ScanView none = v;
+  none.count = 0;
+  EXPECT_EQ(scanReach(none, sensor, 0.1), 0.0);
+}
+
 }  // namespace
 }  // namespace wavog

@@ -116,10 +116,11 @@ class WaveletMap {
   /// Counts; `count_observed` also walks the tree to count observed cells (O(nodes)).
   MapStats stats(bool count_observed = false) const;
 
- private:
-  friend class ScanIntegrator;
-  friend struct MapAccess;  // tests and benchmarks inspect internals through this
+  /// Opaque storage, defined in src/core/map_impl.h (named here so the core's sources can use it).
   struct Impl;
+
+ private:
+  friend struct MapAccess;  // tests inspect internals through this
   std::unique_ptr<Impl> impl_;
 };
 

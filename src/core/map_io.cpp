@@ -1,0 +1,229 @@
+// Native map files. Layout (little-endian, version 1):
+//   "WAVOGMAP" | u32 version | f64 resolution | i32 block_levels | f64 prior | f64 a (= 1 - gamma
+//   of the pending forgetting tags) | u64 block count
+//   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
+//              [root subtree, pre-order: f32 dx dy dxy (stored) | u8 pending count k |
+//               u8 child_mask | u8 known_all | u8 known_any | children in q order]
+//   u32 CRC-32 (IEEE) of every byte before it.
+// Stored details and lazy counts are written as they are, so a round trip is bit-exact; a map
+// loaded under another gamma applies the file's pending tags while loading.
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "map_impl.h"
+#include "wavog_mapping/core/wavelet_map.h"
+
+namespace wavog {
+namespace {
+
+using detail::Block;
+using detail::Node;
+
+constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
+constexpr std::uint32_t kVersion = 1;
+
+std::uint32_t crc32(const unsigned char* data, std::size_t size) {
+  static const std::array<std::uint32_t, 256> table = [] {
+    std::array<std::uint32_t, 256> t{};
+    for (std::uint32_t i = 0; i < 256; ++i) {
+      std::uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      t[i] = c;
+    }
+    return t;
+  }();
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xFFu] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+class Writer {
+ public:
+  template <typename T>
+  void put(T v) {
+    const auto* p = reinterpret_cast<const unsigned char*>(&v);
+    buf_.insert(buf_.end(), p, p + sizeof(T));
+  }
+  void bytes(const char* p, std::size_t n) { buf_.insert(buf_.end(), p, p + n); }
+  std::vector<unsigned char>& buffer() { return buf_; }
+
+ private:
+  std::vector<unsigned char> buf_;
+};
+
+class Reader {
+ public:
+  Reader(const unsigned char* data, std::size_t size) : p_(data), end_(data + size) {}
+  template <typename T>
+  T get() {
+    if (static_cast<std::size_t>(end_ - p_) < sizeof(T)) throw std::out_of_range("truncated");
+    T v;
+    std::memcpy(&v, p_, sizeof(T));
+    p_ += sizeof(T);
+    return v;
+  }
+  bool done() const { return p_ == end_; }
+
+ private:
+  const unsigned char* p_;
+  const unsigned char* end_;
+};
+
+void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
+  for (float d : n.d) w->put(d);
+  w->put(n.k);
+  w->put(n.child_mask);
+  w->put(n.known_all);
+  w->put(n.known_any);
+  if (l <= 1) return;
+  for (int q = 0; q < 4; ++q) {
+    if (impl.hasChild(n, q)) writeNode(impl, impl.child(n, q), l - 1, w);
+  }
+}
+
+// Reads a subtree into `impl` (a fresh map). Throws std::runtime_error on inconsistent data.
+// `file_a`: the file's forgetting factor; when it differs from the map's, pending counts are
+// applied with it now (`pending` accumulates the ancestors' counts).
+void readNode(WaveletMap::Impl& impl, Node& n, int l, double file_a, int pending, Reader* r) {
+  for (float& d : n.d) {
+    d = r->get<float>();
+    if (!std::isfinite(d)) throw std::runtime_error("non-finite detail");
+  }
+  n.k = r->get<std::uint8_t>();
+  pending += n.k;
+  if (file_a != impl.a) {
+    const auto m = static_cast<float>(std::pow(file_a, pending));
+    for (float& d : n.d) d *= m;
+    n.k = 0;
+  }
+  const auto mask = r->get<std::uint8_t>();
+  n.known_all = r->get<std::uint8_t>();
+  n.known_any = r->get<std::uint8_t>();
+  if (mask > 0xF || n.known_all > 0xF || n.known_any > 0xF || (n.known_all & ~n.known_any) != 0) {
+    throw std::runtime_error("bad node flags");
+  }
+  if (l == 1 && mask != 0) throw std::runtime_error("children below level 1");
+  for (int q = 0; q < 4; ++q) {
+    if (!((mask >> q) & 1u)) continue;
+    Node& c = impl.installChild(n, q, Node{});
+    readNode(impl, c, l - 1, file_a, file_a != impl.a ? pending : 0, r);
+  }
+}
+
+}  // namespace
+
+void WaveletMap::save(const std::string& path) const {
+  const Impl& impl = *impl_;
+  Writer w;
+  w.bytes(kMagic, sizeof(kMagic));
+  w.put(kVersion);
+  w.put(impl.params.grid.resolution);
+  w.put(static_cast<std::int32_t>(impl.levels));
+  w.put(impl.init);
+  w.put(impl.a);
+  w.put(static_cast<std::uint64_t>(impl.blocks.size()));
+  for (const auto& kv : impl.blocks) {
+    const Block& b = kv.second;
+    w.put(static_cast<std::int32_t>(detail::blockKeyX(kv.first)));
+    w.put(static_cast<std::int32_t>(detail::blockKeyY(kv.first)));
+    w.put(b.s);
+    w.put(static_cast<std::uint8_t>((b.known_all ? 1 : 0) | (b.known_any ? 2 : 0) | (b.has_root ? 4 : 0)));
+    if (b.has_root) writeNode(impl, b.root, impl.levels, &w);
+  }
+  auto& buf = w.buffer();
+  const std::uint32_t crc = crc32(buf.data(), buf.size());
+  w.put(crc);
+
+  // Temporary file in the same directory, then an atomic rename over the target.
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw MapIoError("cannot write map file '" + tmp + "': " + std::strerror(errno));
+    out.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw MapIoError("cannot write map file '" + tmp + "': write failed (disk full?)");
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    std::remove(tmp.c_str());
+    throw MapIoError("cannot rename '" + tmp + "' to '" + path + "': " + why);
+  }
+}
+
+void WaveletMap::load(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw MapIoError("cannot open map file '" + path + "': " + std::strerror(errno));
+  const std::vector<unsigned char> data((std::istreambuf_iterator<char>(in)),
+                                        std::istreambuf_iterator<char>());
+  const auto fail = [&](const std::string& why) {
+    return MapIoError("map file '" + path + "' rejected: " + why);
+  };
+  if (data.size() < sizeof(kMagic) + 4 || std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
+    throw fail("not a wavog map (bad magic)");
+  }
+  Reader header(data.data() + sizeof(kMagic), data.size() - sizeof(kMagic));
+  const auto version = header.get<std::uint32_t>();
+  if (version != kVersion) {
+    throw fail("format version " + std::to_string(version) + ", this build reads version " +
+               std::to_string(kVersion));
+  }
+  if (data.size() < sizeof(kMagic) + 4 + 4) throw fail("truncated");
+  const std::size_t body = data.size() - 4;
+  std::uint32_t stored_crc;
+  std::memcpy(&stored_crc, data.data() + body, 4);
+  if (crc32(data.data(), body) != stored_crc) throw fail("checksum mismatch (truncated or corrupted)");
+
+  Impl fresh(impl_->params);
+  try {
+    Reader r(data.data() + sizeof(kMagic) + 4, body - sizeof(kMagic) - 4);
+    const auto res = r.get<double>();
+    const auto levels = r.get<std::int32_t>();
+    (void)r.get<double>();  // prior at save time: informative only
+    const auto file_a = r.get<double>();
+    if (!(file_a >= 0.0 && file_a <= 1.0)) throw std::runtime_error("bad forgetting factor");
+    if (res != impl_->params.grid.resolution || levels != impl_->levels) {
+      std::ostringstream s;
+      s << "its resolution " << res << " m / block_levels " << levels << " differ from this map's "
+        << impl_->params.grid.resolution << " m / " << impl_->levels;
+      throw fail(s.str());
+    }
+    const auto count = r.get<std::uint64_t>();
+    for (std::uint64_t i = 0; i < count; ++i) {
+      const auto bx = r.get<std::int32_t>();
+      const auto by = r.get<std::int32_t>();
+      const auto s = r.get<double>();
+      const auto flags = r.get<std::uint8_t>();
+      if (!std::isfinite(s) || flags > 7) throw std::runtime_error("bad block header");
+      auto ins = fresh.blocks.try_emplace(detail::blockKey(bx, by));
+      if (!ins.second) throw std::runtime_error("duplicate block");
+      Block& b = ins.first->second;
+      b.s = s;
+      b.known_all = flags & 1;
+      b.known_any = (flags & 2) != 0;
+      b.has_root = (flags & 4) != 0;
+      if (b.has_root) {
+        ++fresh.nodes;
+        readNode(fresh, b.root, fresh.levels, file_a, 0, &r);
+      }
+    }
+    if (!r.done()) throw std::runtime_error("trailing bytes");
+  } catch (const MapIoError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw fail(std::string("malformed content: ") + e.what());
+  }
+  *impl_ = std::move(fresh);
+}
+
+}  // namespace wavog

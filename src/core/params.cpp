@@ -1,0 +1,147 @@
+#include "wavog_mapping/core/params.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "wavog_mapping/core/types.h"
+
+namespace wavog {
+namespace {
+
+struct PolicyName {
+  PolicyType type;
+  const char* name;
+};
+constexpr PolicyName kPolicyNames[] = {
+    {PolicyType::kNone, "none"},           {PolicyType::kMax, "max"},
+    {PolicyType::kClamp, "clamp"},         {PolicyType::kForget, "forget"},
+    {PolicyType::kClampLower, "clamp_lower"}, {PolicyType::kClampUpper, "clamp_upper"},
+};
+
+// Appends "<name> (<value>) must be <rule>" when `ok` is false.
+void check(bool ok, const char* name, double value, const char* rule,
+           std::vector<std::string>* out) {
+  if (ok) return;
+  std::ostringstream s;
+  s << name << " (" << value << ") must be " << rule;
+  out->push_back(s.str());
+}
+
+bool usesLowerClamp(PolicyType t) { return t == PolicyType::kClamp || t == PolicyType::kClampLower; }
+bool usesUpperClamp(PolicyType t) { return t == PolicyType::kClamp || t == PolicyType::kClampUpper; }
+
+}  // namespace
+
+const char* toString(ScanStatus status) {
+  switch (status) {
+    case ScanStatus::kOk: return "ok";
+    case ScanStatus::kEmpty: return "empty_scan";
+    case ScanStatus::kBadGeometry: return "bad_geometry";
+    case ScanStatus::kBadPose: return "bad_pose";
+    case ScanStatus::kNoValidBeam: return "no_valid_beam";
+  }
+  return "unknown";
+}
+
+const char* toString(PolicyType type) {
+  for (const auto& p : kPolicyNames) {
+    if (p.type == type) return p.name;
+  }
+  return "unknown";
+}
+
+const char* toString(InitValue init) {
+  return init == InitValue::kUnknown ? "unknown" : "empty_bound";
+}
+
+bool fromString(const std::string& name, PolicyType* type) {
+  for (const auto& p : kPolicyNames) {
+    if (name == p.name) {
+      *type = p.type;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool fromString(const std::string& name, InitValue* init) {
+  if (name == "unknown") {
+    *init = InitValue::kUnknown;
+    return true;
+  }
+  if (name == "empty_bound") {
+    *init = InitValue::kEmptyBound;
+    return true;
+  }
+  return false;
+}
+
+std::vector<std::string> MapParams::validate() const {
+  std::vector<std::string> v;
+  const auto finite = [](double x) { return std::isfinite(x); };
+  check(finite(grid.resolution) && grid.resolution > 0.001 && grid.resolution <= 100.0,
+        "resolution", grid.resolution, "in (0.001, 100] m", &v);
+  check(grid.block_levels >= 2 && grid.block_levels <= 12, "block_levels", grid.block_levels,
+        "an integer in [2, 12]", &v);
+  check(finite(sensor.odd_occ) && sensor.odd_occ > 0.0 && sensor.odd_occ <= 50.0, "odd_occ",
+        sensor.odd_occ, "in (0, 50] log-odds", &v);
+  check(finite(sensor.odd_emp) && sensor.odd_emp < 0.0 && sensor.odd_emp >= -50.0, "odd_emp",
+        sensor.odd_emp, "in [-50, 0) log-odds", &v);
+  check(finite(sensor.band_width) && sensor.band_width >= 0.0 && sensor.band_width <= 10.0,
+        "band_width", sensor.band_width, "in [0, 10] m (0: one cell)", &v);
+  check(finite(sensor.max_range) && sensor.max_range >= 0.0, "max_range", sensor.max_range,
+        ">= 0 m (0: the scan's range_max)", &v);
+  check(finite(sensor.no_return_clear) && sensor.no_return_clear >= 0.0, "no_return_clear",
+        sensor.no_return_clear, ">= 0 m (0: no-return beams clear nothing)", &v);
+  check(finite(policy.gamma) && policy.gamma > 0.0 && policy.gamma <= 1.0, "gamma", policy.gamma,
+        "in (0, 1]", &v);
+  check(finite(policy.clamp_min) && policy.clamp_min < 0.0, "clamp_min", policy.clamp_min,
+        "< 0 log-odds", &v);
+  check(finite(policy.clamp_max) && policy.clamp_max > 0.0, "clamp_max", policy.clamp_max,
+        "> 0 log-odds", &v);
+  check(finite(prune_threshold) && prune_threshold >= 0.0 && prune_threshold <= 1.0,
+        "prune_threshold", prune_threshold, "in [0, 1] log-odds", &v);
+  check(finite(skip_tolerance) && skip_tolerance >= 0.0 && skip_tolerance <= 1.0,
+        "skip_tolerance", skip_tolerance, "in [0, 1] log-odds", &v);
+  // The empty update must be able to move a cell: with a lower clamp, odd_emp cannot be smaller
+  // than the whole clamp interval without making the upper bound unreachable in one step.
+  if (usesLowerClamp(policy.type) && usesUpperClamp(policy.type)) {
+    check(policy.clamp_min < policy.clamp_max, "clamp_min", policy.clamp_min,
+          "< clamp_max", &v);
+  }
+  return v;
+}
+
+MapParams MapParams::defaultsFor(PolicyType type) {
+  MapParams p;
+  p.policy.type = type;
+  if (type == PolicyType::kForget) {
+    // Fixed points of the forgetting (ALGORITHM.md section 4): asymptotic confidences.
+    p.sensor.odd_occ = 3.5;
+    p.sensor.odd_emp = -2.0;
+  } else {
+    // OctoMap's usual hit 0.7 / miss 0.4 in log-odds; clamp 0.12 / 0.97.
+    p.sensor.odd_occ = 0.85;
+    p.sensor.odd_emp = -0.4;
+  }
+  p.policy.clamp_min = -2.0;
+  p.policy.clamp_max = 3.5;
+  p.policy.gamma = 0.3;
+  return p;
+}
+
+double MapParams::initValue() const {
+  if (policy.init == InitValue::kUnknown) return 0.0;
+  return usesLowerClamp(policy.type) ? policy.clamp_min : sensor.odd_emp;
+}
+
+void throwIfInvalid(const MapParams& params) {
+  const auto errors = params.validate();
+  if (errors.empty()) return;
+  std::string msg = "invalid map parameters:";
+  for (const auto& e : errors) msg += "\n  " + e;
+  throw std::invalid_argument(msg);
+}
+
+}  // namespace wavog

@@ -1,0 +1,475 @@
+// Coarse-to-fine integration of one scan (ALGORITHM.md sections 3 and 6).
+//
+// Per scan: beams are classified per REP 117 into hit / clearing / invalid, with their E and U
+// limits zE, zU; sparse tables give min zE and max zU over any beam interval in O(1); hit cells
+// are binned. Per node: the node's range and bearing interval against those tables give U, E,
+// FREE_OR_UNKNOWN or MIXED without looping over beams (conservative: never E or U wrongly).
+// U is skipped, E is applied at the node's own scale (a lazy tag with forgetting), the rest
+// descends; finest cells are classified exactly like the dense reference does, cell by cell.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "map_impl.h"
+#include "wavog_mapping/core/haar.h"
+#include "wavog_mapping/core/wavelet_map.h"
+
+namespace wavog {
+namespace {
+
+using detail::Block;
+using detail::Node;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 2.0 * kPi;
+// Slack on beam-index bounds (in beams) so rounding in atan2 never misses a beam.
+constexpr double kIndexSlack = 1e-6;
+// Numerical floor of the "E update changes nothing" test (log-odds).
+constexpr double kUnchangedFloor = 1e-9;
+
+enum BeamKind : std::uint8_t { kInvalid = 0, kHit = 1, kClear = 2 };
+
+/// Everything about one scan that node and cell classification need. Reused between scans.
+struct PreparedScan {
+  double px = 0, py = 0, theta = 0;  // sensor pose
+  double amin = 0, inc = 0;          // beam j at amin + j*inc (sensor frame), inc > 0
+  double seam = 0;                   // bearings are normalised into [seam, seam + 2 pi)
+  double res = 0;
+  int n = 0;
+  double reach = 0;                  // max zU over beams
+  std::vector<float> ranges;         // work copy (reordered when inc < 0)
+  std::vector<std::uint8_t> kind;
+  std::vector<double> ze, zu;
+  std::vector<double> min_ze, max_zu;  // sparse tables, level-major, n entries per level
+  std::vector<int> invalid_prefix;     // invalid_prefix[j] = #invalid beams in [0, j)
+  std::vector<std::uint64_t> hits;     // sorted cell keys of hit endpoints
+
+  static std::uint64_t cellKey(std::int64_t ix, std::int64_t iy) {
+    return (static_cast<std::uint64_t>(ix + (std::int64_t{1} << 31)) << 32) ^
+           static_cast<std::uint64_t>(iy + (std::int64_t{1} << 31));
+  }
+
+  double normalise(double bearing) const {
+    return bearing - kTwoPi * std::floor((bearing - seam) / kTwoPi);
+  }
+
+  /// Class of the finest cell (ix, iy): O if a hit falls in it (O wins), else sampled at the
+  /// cell centre with the sector model. The dense reference in test/core repeats this rule.
+  CellClass classifyCell(std::int64_t ix, std::int64_t iy) const {
+    if (std::binary_search(hits.begin(), hits.end(), cellKey(ix, iy))) return CellClass::kOccupied;
+    const double dx = (static_cast<double>(ix) + 0.5) * res - px;
+    const double dy = (static_cast<double>(iy) + 0.5) * res - py;
+    const double rho = std::sqrt(dx * dx + dy * dy);
+    const double beta = normalise(std::atan2(dy, dx) - theta);
+    const long j = std::lround((beta - amin) / inc);
+    if (j < 0 || j >= n) return CellClass::kUnknown;
+    const auto ju = static_cast<std::size_t>(j);
+    if (kind[ju] == kInvalid) return CellClass::kUnknown;
+    if (rho < ze[ju]) return CellClass::kEmpty;
+    if (kind[ju] == kHit && rho <= zu[ju]) return CellClass::kOccupied;
+    return CellClass::kUnknown;
+  }
+
+  double queryMin(int lo, int hi) const {
+    const int k = 31 - __builtin_clz(static_cast<unsigned>(hi - lo + 1));
+    const std::size_t base = static_cast<std::size_t>(k) * static_cast<std::size_t>(n);
+    return std::min(min_ze[base + static_cast<std::size_t>(lo)],
+                    min_ze[base + static_cast<std::size_t>(hi - (1 << k) + 1)]);
+  }
+  double queryMax(int lo, int hi) const {
+    const int k = 31 - __builtin_clz(static_cast<unsigned>(hi - lo + 1));
+    const std::size_t base = static_cast<std::size_t>(k) * static_cast<std::size_t>(n);
+    return std::max(max_zu[base + static_cast<std::size_t>(lo)],
+                    max_zu[base + static_cast<std::size_t>(hi - (1 << k) + 1)]);
+  }
+
+  /// Class of the square of side 2^l cells at cell (ix0, iy0), conservative: kEmpty only if
+  /// every cell in it is E, kUnknown only if every cell is U, kFreeOrUnknown only if no cell is O.
+  CellClass classifyBox(int l, std::int64_t ix0, std::int64_t iy0) const {
+    const double size = static_cast<double>(std::int64_t{1} << l) * res;
+    const double x0 = static_cast<double>(ix0) * res, y0 = static_cast<double>(iy0) * res;
+    const double x1 = x0 + size, y1 = y0 + size;
+    if (px >= x0 && px <= x1 && py >= y0 && py <= y1) return CellClass::kMixed;
+    const double nx = std::max({x0 - px, 0.0, px - x1}), ny = std::max({y0 - py, 0.0, py - y1});
+    const double r_min = std::sqrt(nx * nx + ny * ny);
+    if (r_min > reach) return CellClass::kUnknown;
+    const double fx = std::max(std::fabs(x0 - px), std::fabs(x1 - px));
+    const double fy = std::max(std::fabs(y0 - py), std::fabs(y1 - py));
+    const double r_max = std::sqrt(fx * fx + fy * fy);
+
+    // Bearing interval of the square (convex, not containing the sensor: span < pi).
+    double b[4] = {normalise(std::atan2(y0 - py, x0 - px) - theta),
+                   normalise(std::atan2(y0 - py, x1 - px) - theta),
+                   normalise(std::atan2(y1 - py, x0 - px) - theta),
+                   normalise(std::atan2(y1 - py, x1 - px) - theta)};
+    double lo = std::min({b[0], b[1], b[2], b[3]}), hi = std::max({b[0], b[1], b[2], b[3]});
+    bool straddles = false;
+    if (hi - lo > kPi) {  // crosses the seam behind the field of view: unwrap
+      straddles = true;
+      for (double& v : b) {
+        if (v < seam + kPi) v += kTwoPi;
+      }
+      lo = std::min({b[0], b[1], b[2], b[3]});
+      hi = std::max({b[0], b[1], b[2], b[3]});
+    }
+    // Beams j whose sector may hold a point of [lo, hi]: the cells' lround() lands in [jlo, jhi].
+    auto beamRange = [&](double a_lo, double a_hi, long* jlo, long* jhi) {
+      const double t_lo = (a_lo - amin) / inc - 0.5 - kIndexSlack;
+      const double t_hi = (a_hi - amin) / inc + 0.5 + kIndexSlack;
+      *jlo = static_cast<long>(std::ceil(std::max(t_lo, -1.0)));
+      *jhi = static_cast<long>(std::floor(std::min(t_hi, static_cast<double>(n))));
+    };
+    long jlo, jhi;
+    beamRange(lo, hi, &jlo, &jhi);
+    bool partial = straddles || jlo < 0 || jhi > n - 1;
+    jlo = std::max(jlo, 0L);
+    jhi = std::min(jhi, static_cast<long>(n - 1));
+    if (straddles) {
+      long klo, khi;
+      beamRange(lo - kTwoPi, hi - kTwoPi, &klo, &khi);
+      klo = std::max(klo, 0L);
+      khi = std::min(khi, static_cast<long>(n - 1));
+      if (klo <= khi) {
+        if (jlo <= jhi) {
+          jlo = std::min(jlo, klo);  // union covered by its hull: conservative
+          jhi = std::max(jhi, khi);
+        } else {
+          jlo = klo;
+          jhi = khi;
+        }
+      }
+    }
+    if (jlo > jhi) return CellClass::kUnknown;
+    const int ilo = static_cast<int>(jlo), ihi = static_cast<int>(jhi);
+    const double zu_max = queryMax(ilo, ihi);
+    if (r_min > zu_max) return CellClass::kUnknown;
+    const double ze_min = queryMin(ilo, ihi);
+    if (r_max < ze_min) {
+      const bool any_invalid =
+          invalid_prefix[static_cast<std::size_t>(ihi) + 1] > invalid_prefix[static_cast<std::size_t>(ilo)];
+      return (partial || any_invalid) ? CellClass::kFreeOrUnknown : CellClass::kEmpty;
+    }
+    return CellClass::kMixed;
+  }
+};
+
+/// Validates the scan and fills `ps`. Beam counts go to `st`.
+ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& scan,
+                   PreparedScan* ps, IntegrateStats* st) {
+  if (scan.count == 0 || scan.ranges == nullptr) return ScanStatus::kEmpty;
+  const double n_beams = static_cast<double>(scan.count);
+  if (!std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
+      scan.angle_increment == 0.0 || !std::isfinite(scan.range_min) || scan.range_min < 0.0 ||
+      !(scan.range_max > scan.range_min) || std::isnan(scan.range_max) ||
+      std::fabs(scan.angle_increment) * n_beams > kTwoPi + 1e-6 || scan.count > (1u << 24)) {
+    return ScanStatus::kBadGeometry;
+  }
+  if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
+    return ScanStatus::kBadPose;
+  }
+  const int n = static_cast<int>(scan.count);
+  const auto nu = static_cast<std::size_t>(n);
+  ps->n = n;
+  ps->px = pose.x;
+  ps->py = pose.y;
+  ps->theta = pose.theta;
+  ps->res = params.grid.resolution;
+  ps->ranges.assign(scan.ranges, scan.ranges + n);
+  if (scan.angle_increment > 0) {
+    ps->amin = scan.angle_min;
+    ps->inc = scan.angle_increment;
+  } else {  // same beams, ascending bearings
+    ps->amin = scan.angle_min + scan.angle_increment * (n_beams - 1.0);
+    ps->inc = -scan.angle_increment;
+    std::reverse(ps->ranges.begin(), ps->ranges.end());
+  }
+  const double amax = ps->amin + ps->inc * (n_beams - 1.0);
+  ps->seam = 0.5 * (ps->amin + amax) - kPi;
+
+  const double sensor_max =
+      params.sensor.max_range > 0 ? std::min(params.sensor.max_range, scan.range_max) : scan.range_max;
+  const double half_band =
+      0.5 * (params.sensor.band_width > 0 ? params.sensor.band_width : params.grid.resolution);
+  const double clear = params.sensor.no_return_clear;
+  const double inf = std::numeric_limits<double>::infinity();
+  ps->kind.assign(nu, kInvalid);
+  ps->ze.assign(nu, inf);
+  ps->zu.assign(nu, -inf);
+  ps->invalid_prefix.assign(nu + 1, 0);
+  ps->hits.clear();
+  ps->reach = 0.0;
+  for (std::size_t j = 0; j < nu; ++j) {
+    const double z = ps->ranges[j];
+    std::uint8_t kind = kInvalid;
+    if (std::isnan(z) || z == -inf || z <= 0.0 || z < scan.range_min) {
+      ++st->beams_invalid;
+    } else if (z >= sensor_max) {  // +inf and out-of-range readings: no return (REP 117)
+      ++st->beams_no_return;
+      if (clear > 0) {
+        kind = kClear;
+        ps->ze[j] = clear;
+        ps->zu[j] = clear;
+      }
+    } else {
+      ++st->beams_hit;
+      kind = kHit;
+      ps->ze[j] = z - half_band;
+      ps->zu[j] = z + half_band;
+      const double bearing = pose.theta + (ps->amin + static_cast<double>(j) * ps->inc);
+      const double ex = pose.x + z * std::cos(bearing), ey = pose.y + z * std::sin(bearing);
+      ps->hits.push_back(PreparedScan::cellKey(static_cast<std::int64_t>(std::floor(ex / ps->res)),
+                                               static_cast<std::int64_t>(std::floor(ey / ps->res))));
+    }
+    ps->kind[j] = kind;
+    if (kind != kInvalid) ps->reach = std::max(ps->reach, ps->zu[j]);
+    ps->invalid_prefix[j + 1] = ps->invalid_prefix[j] + (kind == kInvalid ? 1 : 0);
+  }
+  if (ps->invalid_prefix[nu] == n) return ScanStatus::kNoValidBeam;
+  std::sort(ps->hits.begin(), ps->hits.end());
+  ps->hits.erase(std::unique(ps->hits.begin(), ps->hits.end()), ps->hits.end());
+
+  // Sparse tables: level k holds min/max over [j, j + 2^k).
+  int levels = 1;
+  while ((1 << levels) <= n) ++levels;
+  ps->min_ze.resize(static_cast<std::size_t>(levels) * nu);
+  ps->max_zu.resize(static_cast<std::size_t>(levels) * nu);
+  std::copy(ps->ze.begin(), ps->ze.end(), ps->min_ze.begin());
+  std::copy(ps->zu.begin(), ps->zu.end(), ps->max_zu.begin());
+  for (int k = 1; k < levels; ++k) {
+    const std::size_t base = static_cast<std::size_t>(k) * nu, prev = base - nu;
+    const std::size_t half = std::size_t{1} << (k - 1);
+    for (std::size_t j = 0; j + (std::size_t{1} << k) <= nu; ++j) {
+      ps->min_ze[base + j] = std::min(ps->min_ze[prev + j], ps->min_ze[prev + j + half]);
+      ps->max_zu[base + j] = std::max(ps->max_zu[prev + j], ps->max_zu[prev + j + half]);
+    }
+  }
+  return ScanStatus::kOk;
+}
+
+/// Policy constants for one scan.
+struct PolicyConsts {
+  double odd_occ, odd_emp, a, g, lo, hi, unchanged_tol;
+};
+
+template <PolicyType P>
+inline double applyPolicy(const PolicyConsts& pc, CellClass cls, double x) {
+  const double o = cls == CellClass::kOccupied ? pc.odd_occ : pc.odd_emp;
+  if constexpr (P == PolicyType::kNone) return x + o;
+  if constexpr (P == PolicyType::kMax) return std::max(x, o);
+  if constexpr (P == PolicyType::kClamp) return std::min(std::max(x + o, pc.lo), pc.hi);
+  if constexpr (P == PolicyType::kForget) return pc.a * x + pc.g * o;
+  if constexpr (P == PolicyType::kClampLower) return std::max(x + o, pc.lo);
+  if constexpr (P == PolicyType::kClampUpper) return std::min(x + o, pc.hi);
+  return x;
+}
+
+/// The E update is affine on every cell (so exact on a block average, details untouched or
+/// scaled): none, forget, and clamp_upper (x + odd_emp < x <= hi never reaches the bound).
+template <PolicyType P>
+constexpr bool kAffineEmpty =
+    P == PolicyType::kNone || P == PolicyType::kForget || P == PolicyType::kClampUpper;
+
+template <PolicyType P>
+class Integrator {
+ public:
+  Integrator(WaveletMap::Impl& impl, const PreparedScan& ps, const PolicyConsts& pc)
+      : impl_(impl), ps_(ps), pc_(pc), lazy_(impl.params.lazy_forgetting) {}
+
+  std::uint64_t visited() const { return visited_; }
+
+  void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, CellClass cls) {
+    const int L = impl_.levels;
+    Node* root = b.has_root ? &b.root : nullptr;
+    bool all = b.known_all, any = b.known_any;
+    b.s += processSlot(
+        root, cls, L, ix0, iy0, b.s, &all, &any,
+        [&](const Node& m) {
+          b.root = m;
+          b.has_root = true;
+          ++impl_.nodes;
+        },
+        [&]() {
+          impl_.freeSubtree(b.root);
+          b.has_root = false;
+          --impl_.nodes;
+        });
+    b.known_all = all;
+    b.known_any = any;
+  }
+
+ private:
+  // Updates one slot (a node at level l >= 1, or a uniform block when `node` is null) of class
+  // `cls` whose average is s; returns the change of that average. `all`/`any` are the slot's
+  // knowledge bits, updated. install(m) stores a new node, remove() deletes the existing one.
+  template <typename Install, typename Remove>
+  double processSlot(Node* node, CellClass cls, int l, std::int64_t ix0, std::int64_t iy0,
+                     double s, bool* all, bool* any, Install install, Remove remove) {
+    switch (cls) {
+      case CellClass::kUnknown:
+        return 0.0;
+      case CellClass::kEmpty:
+        if (node == nullptr) {  // uniform block: exact for every policy
+          *all = *any = true;
+          return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
+        }
+        if (kAffineEmpty<P> && node->known_all == 0xF) {
+          if constexpr (P == PolicyType::kForget) {
+            if (lazy_) {
+              // ALGORITHM.md 6.3: the multiplicative part waits in the tag, the additive part
+              // reaches the parent now through the returned change of the average.
+              impl_.addPending(*node, 1);
+              if (node->k >= impl_.k_star) remove();  // section 6.5: subtree negligible
+            } else {
+              scaleSubtree(*node);
+            }
+          }
+          *all = *any = true;
+          return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
+        }
+        break;  // detail below (non-affine policy) or knowledge still to record: descend
+      case CellClass::kFreeOrUnknown:
+        // ALGORITHM.md 3.4: the E part would not change a uniform, fully known block.
+        if (node == nullptr && *all &&
+            std::fabs(applyPolicy<P>(pc_, CellClass::kEmpty, s) - s) <= pc_.unchanged_tol) {
+          return 0.0;
+        }
+        break;
+      default:
+        break;
+    }
+    Node tmp;
+    if (node == nullptr) {
+      tmp.known_all = *all ? 0xF : 0;
+      tmp.known_any = *any ? 0xF : 0;
+    }
+    Node& m = node ? *node : tmp;
+    const double ds = visitNode(m, l, ix0, iy0, s);
+    *all = m.known_all == 0xF;
+    *any = m.known_any != 0;
+    if (impl_.isTrivial(m)) {
+      if (node) remove();
+    } else if (!node) {
+      install(m);
+    }
+    return ds;
+  }
+
+  // Descends through node n (level l, average s): flushes its tag (F1), updates its 4 children,
+  // folds their average changes into n's details with one forward Haar step.
+  double visitNode(Node& n, int l, std::int64_t ix0, std::int64_t iy0, double s) {
+    ++visited_;
+    impl_.flush(n);
+    const std::array<double, 4> c = haar::backward(s, n.d);
+    std::array<double, 4> delta{};
+    const std::int64_t half = std::int64_t{1} << (l - 1);
+    for (int q = 0; q < 4; ++q) {
+      const auto qu = static_cast<std::size_t>(q);
+      const std::int64_t cx = ix0 + ((q & 1) ? half : 0), cy = iy0 + ((q & 2) ? half : 0);
+      const auto bit = static_cast<std::uint8_t>(1u << q);
+      if (l == 1) {
+        ++visited_;
+        const CellClass cls = ps_.classifyCell(cx, cy);
+        if (cls == CellClass::kUnknown) continue;
+        delta[qu] = applyPolicy<P>(pc_, cls, c[qu]) - c[qu];
+        n.known_all |= bit;
+        n.known_any |= bit;
+        continue;
+      }
+      const CellClass cls = ps_.classifyBox(l - 1, cx, cy);
+      ++visited_;
+      Node* ch = impl_.hasChild(n, q) ? &impl_.child(n, q) : nullptr;
+      bool all = (n.known_all & bit) != 0, any = (n.known_any & bit) != 0;
+      delta[qu] = processSlot(
+          ch, cls, l - 1, cx, cy, c[qu], &all, &any,
+          [&](const Node& m) { impl_.installChild(n, q, m); }, [&]() { impl_.removeChild(n, q); });
+      n.known_all = static_cast<std::uint8_t>(all ? (n.known_all | bit) : (n.known_all & ~bit));
+      n.known_any = static_cast<std::uint8_t>(any ? (n.known_any | bit) : (n.known_any & ~bit));
+    }
+    haar::Details<double> dd;
+    const double ds = haar::forward(delta, &dd);
+    for (int i = 0; i < 3; ++i) {
+      n.d[i] = static_cast<float>(static_cast<double>(n.d[i]) + dd[static_cast<std::size_t>(i)]);
+    }
+    return ds;
+  }
+
+  // Eager forgetting (lazy tags off): every detail of the subtree times a, now.
+  void scaleSubtree(Node& n) {
+    ++visited_;
+    const auto a = static_cast<float>(pc_.a);
+    for (float& d : n.d) d *= a;
+    if (n.children == 0) return;
+    for (int q = 0; q < 4; ++q) {
+      if (impl_.hasChild(n, q)) scaleSubtree(impl_.child(n, q));
+    }
+  }
+
+  WaveletMap::Impl& impl_;
+  const PreparedScan& ps_;
+  const PolicyConsts pc_;
+  const bool lazy_;
+  std::uint64_t visited_ = 0;
+};
+
+template <PolicyType P>
+std::uint64_t integrateAll(WaveletMap::Impl& impl, const PreparedScan& ps, IntegrateStats* st) {
+  const MapParams& p = impl.params;
+  const PolicyConsts pc{p.sensor.odd_occ,
+                        p.sensor.odd_emp,
+                        impl.a,
+                        P == PolicyType::kForget ? p.policy.gamma : 0.0,
+                        p.policy.clamp_min,
+                        p.policy.clamp_max,
+                        std::max(p.skip_tolerance, kUnchangedFloor)};
+  Integrator<P> integrator(impl, ps, pc);
+  const int L = impl.levels;
+  const double block_size = static_cast<double>(std::int64_t{1} << L) * ps.res;
+  const auto lo_x = static_cast<std::int64_t>(std::floor((ps.px - ps.reach) / block_size));
+  const auto hi_x = static_cast<std::int64_t>(std::floor((ps.px + ps.reach) / block_size));
+  const auto lo_y = static_cast<std::int64_t>(std::floor((ps.py - ps.reach) / block_size));
+  const auto hi_y = static_cast<std::int64_t>(std::floor((ps.py + ps.reach) / block_size));
+  std::uint64_t visited = 0;
+  for (std::int64_t by = lo_y; by <= hi_y; ++by) {
+    for (std::int64_t bx = lo_x; bx <= hi_x; ++bx) {
+      const std::int64_t ix0 = bx << L, iy0 = by << L;
+      const CellClass cls = ps.classifyBox(L, ix0, iy0);
+      ++visited;
+      if (cls == CellClass::kUnknown) continue;
+      ++st->blocks_touched;
+      integrator.integrateBlock(impl.getOrCreateBlock(bx, by), ix0, iy0, cls);
+    }
+  }
+  return visited + integrator.visited();
+}
+
+}  // namespace
+
+IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& scan) {
+  IntegrateStats st;
+  thread_local PreparedScan ps;
+  st.status = prepare(impl_->params, sensor_pose, scan, &ps, &st);
+  if (st.status != ScanStatus::kOk) {
+    impl_->nodes_visited_last = 0;
+    return st;
+  }
+  std::uint64_t visited = 0;
+  switch (impl_->params.policy.type) {
+    case PolicyType::kNone: visited = integrateAll<PolicyType::kNone>(*impl_, ps, &st); break;
+    case PolicyType::kMax: visited = integrateAll<PolicyType::kMax>(*impl_, ps, &st); break;
+    case PolicyType::kClamp: visited = integrateAll<PolicyType::kClamp>(*impl_, ps, &st); break;
+    case PolicyType::kForget: visited = integrateAll<PolicyType::kForget>(*impl_, ps, &st); break;
+    case PolicyType::kClampLower:
+      visited = integrateAll<PolicyType::kClampLower>(*impl_, ps, &st);
+      break;
+    case PolicyType::kClampUpper:
+      visited = integrateAll<PolicyType::kClampUpper>(*impl_, ps, &st);
+      break;
+  }
+  st.nodes_visited = visited;
+  impl_->nodes_visited_last = visited;
+  return st;
+}
+
+}  // namespace wavog

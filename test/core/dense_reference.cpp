@@ -1,0 +1,169 @@
+#include "dense_reference.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <stdexcept>
+#include <utility>
+
+namespace wavog_test {
+
+using wavog::PolicyType;
+
+DenseReference::DenseReference(const wavog::MapParams& params, const wavog::CellBox& extent)
+    : DenseReference(std::vector<wavog::MapParams>{params}, extent) {}
+
+DenseReference::DenseReference(const std::vector<wavog::MapParams>& layers,
+                               const wavog::CellBox& extent)
+    : layers_(layers), p_(layers.at(0)), extent_(extent) {
+  const auto n = static_cast<std::size_t>(extent.width() * extent.height());
+  for (const auto& p : layers_) {
+    if (p.grid.resolution != p_.grid.resolution || p.sensor.band_width != p_.sensor.band_width ||
+        p.sensor.max_range != p_.sensor.max_range ||
+        p.sensor.no_return_clear != p_.sensor.no_return_clear) {
+      throw std::invalid_argument("reference layers must share the scan geometry");
+    }
+    v_.emplace_back(n, p.initValue());
+  }
+  known_.assign(n, 0);
+}
+
+std::size_t DenseReference::index(std::int64_t ix, std::int64_t iy) const {
+  if (ix < extent_.min_x || ix >= extent_.max_x || iy < extent_.min_y || iy >= extent_.max_y) {
+    throw std::out_of_range("cell outside the reference extent");
+  }
+  return static_cast<std::size_t>((iy - extent_.min_y) * extent_.width() + (ix - extent_.min_x));
+}
+
+double DenseReference::apply(const wavog::MapParams& p, bool occupied, double x) {
+  const double o = occupied ? p.sensor.odd_occ : p.sensor.odd_emp;
+  const double lo = p.policy.clamp_min, hi = p.policy.clamp_max, g = p.policy.gamma;
+  switch (p.policy.type) {
+    case PolicyType::kNone: return x + o;                               // eq. 1.2
+    case PolicyType::kMax: return std::max(x, o);                       // eq. 1.4
+    case PolicyType::kClamp: return std::max(std::min(x + o, hi), lo);  // eq. 1.5
+    case PolicyType::kForget: return (1.0 - g) * x + g * o;             // eq. 1.6
+    case PolicyType::kClampLower: return std::max(x + o, lo);
+    case PolicyType::kClampUpper: return std::min(x + o, hi);
+  }
+  return x;
+}
+
+void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& scan) {
+  last_updated_ = 0;
+  const double kPi = 3.14159265358979323846;
+  // Scans the core refuses change nothing.
+  if (scan.count == 0 || !std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
+      scan.angle_increment == 0.0 || !std::isfinite(scan.range_min) || scan.range_min < 0 ||
+      !(scan.range_max > scan.range_min) ||
+      std::fabs(scan.angle_increment) * static_cast<double>(scan.count) > 2 * kPi + 1e-6 ||
+      !std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
+    return;
+  }
+  const int n = static_cast<int>(scan.count);
+  std::vector<double> ranges(scan.ranges, scan.ranges + n);
+  double amin = scan.angle_min, inc = scan.angle_increment;
+  if (inc < 0) {
+    amin = scan.angle_min + scan.angle_increment * (static_cast<double>(n) - 1.0);
+    inc = -inc;
+    std::reverse(ranges.begin(), ranges.end());
+  }
+  const double amax = amin + inc * (static_cast<double>(n) - 1.0);
+  const double seam = 0.5 * (amin + amax) - kPi;
+  const double res = p_.grid.resolution;
+  const double sensor_max = p_.sensor.max_range > 0 ? std::min(p_.sensor.max_range, scan.range_max)
+                                                    : scan.range_max;
+  const double half_band = 0.5 * (p_.sensor.band_width > 0 ? p_.sensor.band_width : res);
+  const double inf = std::numeric_limits<double>::infinity();
+
+  // Per beam: 0 invalid, 1 hit, 2 clearing no-return; E limit and band end.
+  std::vector<int> kind(static_cast<std::size_t>(n), 0);
+  std::vector<double> ze(static_cast<std::size_t>(n), inf), zu(static_cast<std::size_t>(n), -inf);
+  std::set<std::pair<std::int64_t, std::int64_t>> hits;
+  bool any_valid = false;
+  for (int j = 0; j < n; ++j) {
+    const auto ju = static_cast<std::size_t>(j);
+    const double z = ranges[ju];
+    if (std::isnan(z) || z == -inf || z <= 0 || z < scan.range_min) continue;
+    if (z >= sensor_max) {
+      if (p_.sensor.no_return_clear > 0) {
+        kind[ju] = 2;
+        ze[ju] = zu[ju] = p_.sensor.no_return_clear;
+        any_valid = true;
+      }
+      continue;
+    }
+    kind[ju] = 1;
+    any_valid = true;
+    ze[ju] = z - half_band;
+    zu[ju] = z + half_band;
+    const double bearing = pose.theta + (amin + static_cast<double>(j) * inc);
+    const double ex = pose.x + z * std::cos(bearing), ey = pose.y + z * std::sin(bearing);
+    hits.emplace(static_cast<std::int64_t>(std::floor(ex / res)),
+                 static_cast<std::int64_t>(std::floor(ey / res)));
+  }
+  if (!any_valid) return;
+
+  // Cells farther than every band end are U: visit only the box of radius `reach` (plus a cell).
+  double reach = 0;
+  for (int j = 0; j < n; ++j) reach = std::max(reach, zu[static_cast<std::size_t>(j)]);
+  const auto x_lo = std::max(extent_.min_x, static_cast<std::int64_t>(std::floor((pose.x - reach) / res)) - 1);
+  const auto x_hi = std::min(extent_.max_x, static_cast<std::int64_t>(std::floor((pose.x + reach) / res)) + 2);
+  const auto y_lo = std::max(extent_.min_y, static_cast<std::int64_t>(std::floor((pose.y - reach) / res)) - 1);
+  const auto y_hi = std::min(extent_.max_y, static_cast<std::int64_t>(std::floor((pose.y + reach) / res)) + 2);
+  for (std::int64_t iy = y_lo; iy < y_hi; ++iy) {
+    for (std::int64_t ix = x_lo; ix < x_hi; ++ix) {
+      bool occupied = false, empty = false;
+      if (hits.count({ix, iy})) {
+        occupied = true;
+      } else {
+        const double dx = (static_cast<double>(ix) + 0.5) * res - pose.x;
+        const double dy = (static_cast<double>(iy) + 0.5) * res - pose.y;
+        const double rho = std::sqrt(dx * dx + dy * dy);
+        double beta = std::atan2(dy, dx) - pose.theta;
+        beta -= 2 * kPi * std::floor((beta - seam) / (2 * kPi));
+        const long j = std::lround((beta - amin) / inc);
+        if (j < 0 || j >= n || kind[static_cast<std::size_t>(j)] == 0) continue;
+        const auto ju = static_cast<std::size_t>(j);
+        if (rho < ze[ju]) {
+          empty = true;
+        } else if (kind[ju] == 1 && rho <= zu[ju]) {
+          occupied = true;
+        }
+      }
+      if (!occupied && !empty) continue;
+      const std::size_t i = index(ix, iy);
+      for (std::size_t k = 0; k < layers_.size(); ++k) v_[k][i] = apply(layers_[k], occupied, v_[k][i]);
+      known_[i] = 1;
+      ++last_updated_;
+    }
+  }
+}
+
+double DenseReference::blockMean(int s, std::int64_t bx, std::int64_t by) const {
+  const std::int64_t size = std::int64_t{1} << s;
+  double sum = 0;
+  for (std::int64_t y = by * size; y < (by + 1) * size; ++y)
+    for (std::int64_t x = bx * size; x < (bx + 1) * size; ++x) sum += value(x, y);
+  return sum / static_cast<double>(size * size);
+}
+
+double DenseReference::blockMaxObserved(int s, std::int64_t bx, std::int64_t by) const {
+  const std::int64_t size = std::int64_t{1} << s;
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::int64_t y = by * size; y < (by + 1) * size; ++y)
+    for (std::int64_t x = bx * size; x < (bx + 1) * size; ++x)
+      if (known(x, y)) best = std::max(best, value(x, y));
+  return best;
+}
+
+bool DenseReference::blockAnyKnown(int s, std::int64_t bx, std::int64_t by) const {
+  const std::int64_t size = std::int64_t{1} << s;
+  for (std::int64_t y = by * size; y < (by + 1) * size; ++y)
+    for (std::int64_t x = bx * size; x < (bx + 1) * size; ++x)
+      if (known(x, y)) return true;
+  return false;
+}
+
+}  // namespace wavog_test

@@ -1,0 +1,55 @@
+// The slow dense reference: a plain grid over a fixed window of finest cells that classifies every
+// cell independently against each scan (same E/O/U sector model and REP 117 rules as the core,
+// written again here cell by cell) and applies the policy cell by cell, in double precision.
+#ifndef WAVOG_MAPPING_TEST_CORE_DENSE_REFERENCE_H_
+#define WAVOG_MAPPING_TEST_CORE_DENSE_REFERENCE_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "wavog_mapping/core/params.h"
+#include "wavog_mapping/core/types.h"
+
+namespace wavog_test {
+
+class DenseReference {
+ public:
+  /// `extent`: the finest cells modelled; cells outside it are not tracked.
+  DenseReference(const wavog::MapParams& params, const wavog::CellBox& extent);
+  /// Several layers, one per parameter set, sharing the classification of each scan (all sets
+  /// must share grid and sensor geometry: resolution, band_width, max_range, no_return_clear).
+  DenseReference(const std::vector<wavog::MapParams>& layers, const wavog::CellBox& extent);
+
+  void integrate(const wavog::Pose2& pose, const wavog::ScanView& scan);
+
+  /// Selects the layer that value(), known() and the block functions read (default 0).
+  void selectLayer(std::size_t layer) { layer_ = layer; }
+  double value(std::int64_t ix, std::int64_t iy) const { return v_[layer_][index(ix, iy)]; }
+  bool known(std::int64_t ix, std::int64_t iy) const { return known_[index(ix, iy)] != 0; }
+  const wavog::CellBox& extent() const { return extent_; }
+
+  /// Mean of the 2^s x 2^s block at scale-s index (bx, by) (all cells, unobserved at the prior),
+  /// max over its observed cells (-inf if none), and whether any is observed.
+  double blockMean(int s, std::int64_t bx, std::int64_t by) const;
+  double blockMaxObserved(int s, std::int64_t bx, std::int64_t by) const;
+  bool blockAnyKnown(int s, std::int64_t bx, std::int64_t by) const;
+
+  /// Cells changed by the last scan (for tests of the update footprint).
+  std::size_t lastUpdatedCells() const { return last_updated_; }
+
+ private:
+  std::size_t index(std::int64_t ix, std::int64_t iy) const;
+  static double apply(const wavog::MapParams& p, bool occupied, double x);
+
+  std::vector<wavog::MapParams> layers_;
+  wavog::MapParams p_;  // geometry shared by the layers
+  wavog::CellBox extent_;
+  std::size_t layer_ = 0;
+  std::vector<std::vector<double>> v_;
+  std::vector<std::uint8_t> known_;
+  std::size_t last_updated_ = 0;
+};
+
+}  // namespace wavog_test
+
+#endif  // WAVOG_MAPPING_TEST_CORE_DENSE_REFERENCE_H_

@@ -1,0 +1,172 @@
+// The hierarchical tree must equal the dense cell-by-cell reference for every policy.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "dense_reference.h"
+#include "test_support.h"
+#include "wavog_mapping/io/carmen_reader.h"
+
+namespace wavog_test {
+namespace {
+
+using wavog::Aggregation;
+using wavog::CellBox;
+using wavog::MapParams;
+using wavog::WaveletMap;
+
+constexpr double kTolerance = 1e-4;  // |tree - ref| <= 1e-4 * max(1, |ref|), tau = 0
+
+struct PolicyRun {
+  std::vector<NamedParams> configs;
+  std::vector<std::unique_ptr<WaveletMap>> maps;
+  std::unique_ptr<DenseReference> ref;
+
+  PolicyRun(std::vector<NamedParams> c, const CellBox& extent) : configs(std::move(c)) {
+    std::vector<MapParams> layers;
+    for (const auto& np : configs) {
+      maps.push_back(std::make_unique<WaveletMap>(np.params));
+      layers.push_back(np.params);
+    }
+    ref = std::make_unique<DenseReference>(layers, extent);
+  }
+  void integrate(const OwnedScan& s) {
+    for (auto& m : maps) m->integrate(s.pose, s.view());
+    ref->integrate(s.pose, s.view());
+  }
+  void expectEqual(const std::string& when) {
+    for (std::size_t i = 0; i < maps.size(); ++i) {
+      ref->selectLayer(i);
+      const Comparison c = compare(*maps[i], *ref);
+      EXPECT_LE(c.max_rel_error, kTolerance)
+          << configs[i].name << " " << when << ": worst cell (" << c.worst_x << ", " << c.worst_y
+          << ") tree " << maps[i]->value({c.worst_x, c.worst_y}) << " reference "
+          << ref->value(c.worst_x, c.worst_y);
+      EXPECT_EQ(c.knowledge_mismatches, 0u) << configs[i].name << " " << when;
+    }
+  }
+  // Multiscale read-out: mean equals the reference block mean, max the block max over observed
+  // cells, known iff any observed cell, for scales 0..max_scale over the whole extent.
+  void expectMultiscale(int max_scale) {
+    const CellBox& e = ref->extent();
+    for (std::size_t i = 0; i < maps.size(); ++i) {
+      ref->selectLayer(i);
+      for (int s = 0; s <= max_scale; ++s) {
+        // Scale-s cells lying wholly inside the reference's extent.
+        const CellBox box{-((-e.min_x) >> s), -((-e.min_y) >> s), e.max_x >> s, e.max_y >> s};
+        const auto mean = maps[i]->exportScale(s, box, Aggregation::kMean);
+        const auto mx = maps[i]->exportScale(s, box, Aggregation::kMax);
+        ASSERT_EQ(mean.log_odds.size(), static_cast<std::size_t>(box.width() * box.height()));
+        double worst_mean = 0, worst_max = 0;
+        std::size_t known_bad = 0;
+        for (std::int64_t by = box.min_y; by < box.max_y; ++by) {
+          for (std::int64_t bx = box.min_x; bx < box.max_x; ++bx) {
+            const auto k = static_cast<std::size_t>((by - box.min_y) * box.width() + (bx - box.min_x));
+            // A mean inherits the float round-off of the cells it averages: the tolerance is
+            // relative to the largest of them (unbounded policies reach hundreds).
+            const double want_mean = ref->blockMean(s, bx, by);
+            double scale_of_block = std::fabs(want_mean);
+            const std::int64_t size = std::int64_t{1} << s;
+            for (std::int64_t y = by * size; y < (by + 1) * size; ++y)
+              for (std::int64_t x = bx * size; x < (bx + 1) * size; ++x)
+                scale_of_block = std::max(scale_of_block, std::fabs(ref->value(x, y)));
+            worst_mean = std::max(worst_mean, std::fabs(mean.log_odds[k] - want_mean) /
+                                                  std::max(1.0, scale_of_block));
+            const bool any = ref->blockAnyKnown(s, bx, by);
+            if ((mean.known[k] != 0) != any || (mx.known[k] != 0) != any) ++known_bad;
+            if (any) {
+              const double want_max = ref->blockMaxObserved(s, bx, by);
+              worst_max = std::max(worst_max, std::fabs(mx.log_odds[k] - want_max) /
+                                                  std::max(1.0, std::fabs(want_max)));
+            }
+          }
+        }
+        EXPECT_LE(worst_mean, kTolerance) << configs[i].name << " scale " << s << " mean";
+        EXPECT_LE(worst_max, kTolerance) << configs[i].name << " scale " << s << " max";
+        EXPECT_EQ(known_bad, 0u) << configs[i].name << " scale " << s << " knowledge";
+      }
+    }
+  }
+};
+
+// (a) 300 seeded random scans from random poses with NaN, +-inf, zero and out-of-range beams.
+TEST(ReferenceEquivalence, RandomScansEveryPolicy) {
+  const double half = 12.0;  // poses in +-6 m, range_max 5.4 m
+  for (int levels : {3, 5}) {
+    const double res = 0.1;
+    const auto cells = static_cast<std::int64_t>(std::ceil(half / res));
+    PolicyRun run(everyPolicy(res, levels), CellBox{-cells, -cells, cells, cells});
+    RandomScans scans(1234u + static_cast<std::uint32_t>(levels), half);
+    for (int i = 1; i <= 300; ++i) {
+      run.integrate(scans.next());
+      if (i == 1 || i == 30 || i == 300) run.expectEqual("levels " + std::to_string(levels) + " after " + std::to_string(i) + " scans");
+    }
+    run.expectMultiscale(std::min(levels, 4));
+  }
+}
+
+// A sensor sitting exactly on cell corners and block corners, beams along the axes.
+TEST(ReferenceEquivalence, DegenerateGeometry) {
+  const double res = 0.1;
+  PolicyRun run(everyPolicy(res, 4), CellBox{-64, -64, 64, 64});
+  const double kPi = 3.14159265358979323846;
+  for (int i = 0; i < 40; ++i) {
+    OwnedScan s;
+    s.pose = {(i % 2) ? 0.0 : 1.6, (i % 3) ? 0.0 : -1.6, (i % 4) * kPi / 2};
+    s.angle_min = -kPi;
+    s.angle_increment = kPi / 8;  // 16 beams over 2 pi: beams on the axes and diagonals
+    s.range_min = 0.0;
+    s.range_max = 5.0;
+    for (int j = 0; j < 16; ++j) s.ranges.push_back(j % 5 == 0 ? std::numeric_limits<float>::infinity() : 1.6f + 0.8f * static_cast<float>(j % 3));
+    run.integrate(s);
+  }
+  run.expectEqual("degenerate");
+  run.expectMultiscale(4);
+}
+
+// (b) The first 500 scans of the Freiburg fr079 log.
+TEST(ReferenceEquivalence, Fr079First500Scans) {
+  const std::string dir = dataDir();
+  ASSERT_FALSE(dir.empty());
+  const auto log = wavog::readCarmenLog(dir + "/fr079-corrected.log.gz", 500);
+  ASSERT_EQ(log.size(), 500u);
+  const double res = 0.1;
+  // Extent: every endpoint and pose, with a margin.
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+  for (const auto& s : log) {
+    const auto v = s.view();
+    for (std::size_t j = 0; j < v.count; ++j) {
+      const double z = v.ranges[j];
+      if (!std::isfinite(z) || z >= v.range_max) continue;
+      const double b = s.laser_pose.theta + v.angle_min + static_cast<double>(j) * v.angle_increment;
+      x0 = std::min(x0, s.laser_pose.x + z * std::cos(b));
+      x1 = std::max(x1, s.laser_pose.x + z * std::cos(b));
+      y0 = std::min(y0, s.laser_pose.y + z * std::sin(b));
+      y1 = std::max(y1, s.laser_pose.y + z * std::sin(b));
+    }
+  }
+  const CellBox extent{static_cast<std::int64_t>(std::floor(x0 / res)) - 4,
+                       static_cast<std::int64_t>(std::floor(y0 / res)) - 4,
+                       static_cast<std::int64_t>(std::floor(x1 / res)) + 5,
+                       static_cast<std::int64_t>(std::floor(y1 / res)) + 5};
+  PolicyRun run(everyPolicy(res, 6), extent);
+  for (const auto& s : log) {
+    OwnedScan o;
+    o.pose = s.laser_pose;
+    const auto v = s.view();
+    o.ranges.assign(v.ranges, v.ranges + v.count);
+    o.angle_min = v.angle_min;
+    o.angle_increment = v.angle_increment;
+    o.range_min = v.range_min;
+    o.range_max = v.range_max;
+    run.integrate(o);
+  }
+  run.expectEqual("fr079 500 scans");
+  run.expectMultiscale(4);
+}
+
+}  // namespace
+}  // namespace wavog_test

@@ -1,0 +1,59 @@
+// Shared fixtures of the core tests: parameter sets for every policy, seeded random scans with
+// every kind of bad beam, and the tree-versus-reference comparison.
+#ifndef WAVOG_MAPPING_TEST_CORE_TEST_SUPPORT_H_
+#define WAVOG_MAPPING_TEST_CORE_TEST_SUPPORT_H_
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "dense_reference.h"
+#include "wavog_mapping/core/params.h"
+#include "wavog_mapping/core/wavelet_map.h"
+
+namespace wavog_test {
+
+/// One named configuration per policy (and per initial value where it matters).
+struct NamedParams {
+  std::string name;
+  wavog::MapParams params;
+};
+std::vector<NamedParams> everyPolicy(double resolution, int block_levels);
+
+/// A scan with its own storage.
+struct OwnedScan {
+  wavog::Pose2 pose;
+  std::vector<float> ranges;
+  double angle_min = 0, angle_increment = 0, range_min = 0, range_max = 0;
+  wavog::ScanView view() const;
+};
+
+/// Seeded random scans around the origin inside a square of half-size `half_extent` metres:
+/// random pose, beam count, field of view (up to 2 pi), sign of the increment; ranges mix valid
+/// readings with NaN, +inf, -inf, 0, below range_min and beyond range_max.
+class RandomScans {
+ public:
+  RandomScans(std::uint32_t seed, double half_extent) : rng_(seed), half_(half_extent) {}
+  OwnedScan next();
+
+ private:
+  std::mt19937 rng_;
+  double half_;
+};
+
+/// Largest |tree - reference| / max(1, |reference|) over the reference's extent, and the number
+/// of cells whose observed flag differs.
+struct Comparison {
+  double max_rel_error = 0;
+  std::int64_t worst_x = 0, worst_y = 0;
+  std::size_t knowledge_mismatches = 0;
+};
+Comparison compare(const wavog::WaveletMap& map, const DenseReference& ref);
+
+/// Directory of ../shared/data (or $WAVOG_DATA_DIR); fails the test when missing.
+std::string dataDir();
+
+}  // namespace wavog_test
+
+#endif  // WAVOG_MAPPING_TEST_CORE_TEST_SUPPORT_H_
