@@ -78,11 +78,13 @@ struct Workload {
   std::size_t timed_scans = 0;  ///< scans per timed repetition (a prefix of `scans`)
 };
 
-std::vector<Scan> loadLog(const std::string& path, std::size_t max_scans) {
-  const std::vector<wavog::CarmenScan> log = wavog::readCarmenLog(path, max_scans);
+/// Every `stride`-th scan of a log, up to `max_scans` scans (0: all).
+std::vector<Scan> loadLog(const std::string& path, std::size_t stride, std::size_t max_scans) {
+  const std::vector<wavog::CarmenScan> log = wavog::readCarmenLog(path);
   std::vector<Scan> scans;
-  scans.reserve(log.size());
-  for (const wavog::CarmenScan& c : log) {
+  for (std::size_t i = 0; i < log.size(); i += stride) {
+    if (max_scans != 0 && scans.size() >= max_scans) break;
+    const wavog::CarmenScan& c = log[i];
     Scan s;
     s.pose = c.laser_pose;
     s.ranges = c.ranges;
@@ -376,6 +378,8 @@ struct Options {
   std::vector<double> resolutions = {0.05, 0.10};
   int reps = 5;
   std::size_t max_scans = 0;
+  std::size_t stride_fr079 = 1;
+  std::size_t stride_csail = 1;
   std::size_t timed_scans = 0;
   int synthetic_steps = 25;
   double no_return_clear = 80.0;
@@ -763,7 +767,8 @@ void usage() {
          "  --workloads LIST      fr079,csail,lms291x4 (default: all three)\n"
          "  --resolutions LIST    cell sizes in m (default 0.05,0.1)\n"
          "  --reps N              timed repetitions after the warm-up, >= 1 (default 5)\n"
-         "  --max-scans N         scans read from each log, 0 = all (default 0)\n"
+         "  --max-scans N         scans taken from each log, 0 = all (default 0)\n"
+         "  --stride LIST         take every N-th scan of a log, e.g. fr079=8,csail=14 (default 1)\n"
          "  --timed-scans N       scans per timed repetition (a prefix), 0 = all (default 0)\n"
          "  --synthetic-steps N   steps of the four-LMS-291 workload, 4 scans each (default 25)\n"
          "  --no-return-clear M   no-return beams clear free space up to M metres, 0 = not at all\n"
@@ -795,6 +800,16 @@ int main(int argc, char** argv) {
         opt.reps = std::stoi(value());
       } else if (a == "--max-scans") {
         opt.max_scans = std::stoul(value());
+      } else if (a == "--stride") {
+        for (const std::string& item : splitList(value())) {
+          const std::size_t eq = item.find('=');
+          const std::string key = item.substr(0, eq);
+          const std::size_t n = eq == std::string::npos ? 0 : std::stoul(item.substr(eq + 1));
+          if (n == 0 || (key != "fr079" && key != "csail")) {
+            throw std::invalid_argument("--stride takes fr079=N,csail=N with N >= 1");
+          }
+          (key == "fr079" ? opt.stride_fr079 : opt.stride_csail) = n;
+        }
       } else if (a == "--timed-scans") {
         opt.timed_scans = std::stoul(value());
       } else if (a == "--synthetic-steps") {
@@ -826,10 +841,10 @@ int main(int argc, char** argv) {
   }
   if (opt.smoke) {
     opt.reps = 1;
-    opt.resolutions = {0.1};
-    opt.synthetic_steps = 2;
-    opt.max_scans = 30;
-    opt.crop_cells = 64;
+    opt.resolutions = {0.2};
+    opt.synthetic_steps = 1;
+    opt.max_scans = 10;
+    opt.crop_cells = 32;
   }
   if (opt.data_dir.empty()) opt.data_dir = wavog::findDataDir(WAVOG_SOURCE_DIR);
   makeDirs(opt.out_dir);
@@ -848,11 +863,13 @@ int main(int argc, char** argv) {
           }
           throw std::runtime_error("no data directory (set WAVOG_DATA_DIR or --data)");
         }
-        scans = loadLog(opt.data_dir + "/" + file, opt.max_scans);
-        label = w == "fr079" ? "fr079 (indoor, 360 beams)" : "csail (indoor, 361 beams)";
+        const std::size_t stride = w == "fr079" ? opt.stride_fr079 : opt.stride_csail;
+        scans = loadLog(opt.data_dir + "/" + file, stride, opt.max_scans);
+        label = w == "fr079" ? "fr079" : "csail";
+        if (stride > 1) label += ", every " + std::to_string(stride) + "th scan";
       } else if (w == "lms291x4") {
         scans = syntheticLms291x4(opt.synthetic_steps);
-        label = "4x LMS-291, 60-80 m";
+        label = "4x LMS-291, 60-80 m (synthetic)";
       } else {
         throw std::invalid_argument("unknown workload " + w);
       }

@@ -1,0 +1,17 @@
+# `make compare` (issue 6): builds wavog_compare in its own Release tree (-O3, no -march=native,
+# no ROS) and runs wavog_core (clamping and forgetting), OctoMap and the dense baseline side by
+# side; writes $(COMPARE_OUT)/results.md, results.csv and the disagreement PNGs. Not part of
+# `make test` (CI runs only the smoke test, ctest label "compare"). About 5-8 minutes on 2 cores.
+BUILD_COMPARE ?= $(ROOT)/build-compare
+COMPARE_OUT ?= $(ROOT)/compare_output
+# OctoMap needs seconds per scan on 80 m scans, so the logs are thinned (every 8th fr079 scan,
+# every 14th csail scan) and the synthetic run has 2 steps of 4 scans; see docs/sections/compare.md.
+COMPARE_ARGS ?= --stride fr079=8,csail=14 --synthetic-steps 2 --reps 5
+
+.PHONY: compare
+compare: deps
+	@mkdir -p $(BUILD_COMPARE) $(COMPARE_OUT)
+	@cmake -S $(ROOT) -B $(BUILD_COMPARE) -DCMAKE_BUILD_TYPE=Release -DWAVOG_BUILD_ROS=OFF \
+	  $(CMAKE_ARGS) >$(BUILD_COMPARE)/configure.log || { cat $(BUILD_COMPARE)/configure.log; exit 1; }
+	@cmake --build $(BUILD_COMPARE) --target wavog_compare -j$(JOBS) -- --no-print-directory
+	@cd $(ROOT) && $(BUILD_COMPARE)/bin/wavog_compare --out $(COMPARE_OUT) $(COMPARE_ARGS)
