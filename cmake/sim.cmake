@@ -21,3 +21,12 @@ function(wavog_sim_test name)
 endfunction()
 
 wavog_sim_test(test_simulator wavog_sim)
+
+# ---- wavog_simulate: scenario -> rosbag (rosbag C++ API, no roscore) --------------------------
+set(WAVOG_SIM_BIN_DIR ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+add_executable(wavog_simulate src/tools/simulate.cpp)
+target_include_directories(wavog_simulate SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(wavog_simulate PRIVATE wavog_sim wavog_io ${catkin_LIBRARIES})
+target_compile_options(wavog_simulate PRIVATE ${WAVOG_WARNINGS})
+set_target_properties(wavog_simulate PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_SIM_BIN_DIR})
+install(TARGETS wavog_simulate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

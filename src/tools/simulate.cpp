@@ -1,0 +1,251 @@
+// wavog_simulate: runs a simulated scenario (the built-in car park or a YAML/JSON world file) and
+// writes a rosbag that the mapping node and wavog_offline consume unchanged: one
+// sensor_msgs/LaserScan topic per laser, /tf (map -> base_link at every scan time) and a latched
+// /tf_static (base_link -> each laser). Optionally writes the ground truth (the world file and
+// rasterised occupancy at chosen times). Deterministic for a seed; needs no roscore.
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <iostream>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <sys/stat.h>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <rosbag/bag.h>
+#include <ros/time.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "wavog_mapping/io/image_io.h"
+#include "wavog_mapping/sim/ground_truth.h"
+#include "wavog_mapping/sim/laser_sim.h"
+#include "wavog_mapping/sim/world.h"
+#include "wavog_mapping/sim/world_file.h"
+
+namespace {
+
+using wavog::sim::GridWindow;
+using wavog::sim::LaserParams;
+using wavog::sim::SimScan;
+using wavog::sim::World;
+
+// Bag time of scenario time 0: a plausible epoch, so stamps are never zero (tf treats 0 as
+// "latest") and tools that print dates show something sensible.
+constexpr double kEpoch = 1.7e9;
+
+struct Options {
+  std::string world_file;         // empty: the built-in car park
+  std::string bag = "scenario.bag";
+  std::uint64_t seed = 1;
+  double duration = -1.0;         // < 0: the world's
+  double noise_sigma = -1.0;      // < 0: each laser's
+  double dropout = -1.0;          // < 0: each laser's
+  std::string map_frame = "map";
+  std::string base_frame = "base_link";
+  std::string truth_dir;          // empty: no ground truth written
+  double truth_resolution = 0.1;
+  double truth_every = 10.0;
+  std::string write_world;        // write the world as YAML here
+};
+
+void usage(std::ostream& out) {
+  out << "usage: wavog_simulate [options]\n"
+         "Simulates a vehicle with planar lasers (default: the car park with four LMS-291) and\n"
+         "writes a rosbag: one LaserScan topic per laser, /tf (map -> base_link), /tf_static.\n\n"
+         "  --world FILE          YAML/JSON world (default: the built-in car park)\n"
+         "  --out BAG             output bag (default scenario.bag)\n"
+         "  --seed N              noise seed (default 1); same seed, same bag\n"
+         "  --duration S          simulated seconds (default: the world's, 60 for the car park)\n"
+         "  --noise SIGMA         range noise standard deviation (m) for every laser\n"
+         "  --dropout P           NaN dropout probability per beam for every laser\n"
+         "  --map-frame F         fixed frame of /tf (default map)\n"
+         "  --base-frame F        vehicle frame (default base_link)\n"
+         "  --truth-dir DIR       write ground truth there: world.yaml, truth_<t>.png/.pgm/.yaml\n"
+         "  --truth-resolution R  ground-truth cell size (m, default 0.1)\n"
+         "  --truth-every S       ground-truth snapshot period (s, default 10)\n"
+         "  --write-world FILE    write the world as YAML (e.g. to edit the default) and go on\n";
+}
+
+double parseNumber(const std::string& flag, const char* text) {
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text, &end);
+  if (errno || end == text || *end || !std::isfinite(v)) {
+    throw std::invalid_argument(flag + ": not a number: '" + text + "'");
+  }
+  return v;
+}
+
+Options parseArgs(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help") {
+      usage(std::cout);
+      std::exit(0);
+    }
+    if (i + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + a);
+    const char* v = argv[++i];
+    if (a == "--world") o.world_file = v;
+    else if (a == "--out") o.bag = v;
+    else if (a == "--seed") o.seed = static_cast<std::uint64_t>(parseNumber(a, v));
+    else if (a == "--duration") o.duration = parseNumber(a, v);
+    else if (a == "--noise") o.noise_sigma = parseNumber(a, v);
+    else if (a == "--dropout") o.dropout = parseNumber(a, v);
+    else if (a == "--map-frame") o.map_frame = v;
+    else if (a == "--base-frame") o.base_frame = v;
+    else if (a == "--truth-dir") o.truth_dir = v;
+    else if (a == "--truth-resolution") o.truth_resolution = parseNumber(a, v);
+    else if (a == "--truth-every") o.truth_every = parseNumber(a, v);
+    else if (a == "--write-world") o.write_world = v;
+    else throw std::invalid_argument("unknown option: " + a);
+  }
+  if (!(o.truth_resolution > 0.0)) throw std::invalid_argument("--truth-resolution must be > 0");
+  if (!(o.truth_every > 0.0)) throw std::invalid_argument("--truth-every must be > 0");
+  return o;
+}
+
+geometry_msgs::TransformStamped transformMsg(const std::string& parent, const std::string& child,
+                                             const wavog::Pose2& pose, const ros::Time& stamp) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = parent;
+  t.child_frame_id = child;
+  t.transform.translation.x = pose.x;
+  t.transform.translation.y = pose.y;
+  t.transform.translation.z = 0.0;
+  t.transform.rotation.z = std::sin(pose.theta / 2);
+  t.transform.rotation.w = std::cos(pose.theta / 2);
+  return t;
+}
+
+sensor_msgs::LaserScan scanMsg(const SimScan& scan, const LaserParams& laser,
+                               const ros::Time& stamp) {
+  sensor_msgs::LaserScan m;
+  m.header.stamp = stamp;
+  m.header.frame_id = laser.frame_id;
+  m.angle_min = static_cast<float>(laser.angleMin());
+  m.angle_increment = static_cast<float>(laser.angleIncrement());
+  m.angle_max = static_cast<float>(laser.angleMin() + laser.angleIncrement() * (laser.beams - 1));
+  // The simulated sweep is instantaneous: every beam at the scan's pose.
+  m.time_increment = 0.0f;
+  m.scan_time = static_cast<float>(1.0 / laser.rate_hz);
+  m.range_min = static_cast<float>(laser.range_min);
+  m.range_max = static_cast<float>(laser.range_max);
+  m.ranges = scan.ranges;
+  return m;
+}
+
+std::string absoluteTopic(const std::string& topic) {
+  return topic.empty() || topic[0] == '/' ? topic : "/" + topic;
+}
+
+void writeTruth(const World& world, const Options& o) {
+  if (mkdir(o.truth_dir.c_str(), 0755) != 0 && errno != EEXIST) {
+    throw std::runtime_error(o.truth_dir + ": cannot create directory");
+  }
+  std::ofstream(o.truth_dir + "/world.yaml") << wavog::sim::worldToYaml(world);
+  const GridWindow window =
+      GridWindow::covering(world.region_min, world.region_max, o.truth_resolution);
+  for (double t = 0.0; t < world.duration + 1e-9; t += o.truth_every) {
+    const std::vector<std::uint8_t> occ = wavog::sim::occupancyAt(world, t, window);
+    // As a raster, so the image writers put north up and the map_server YAML gets the origin.
+    wavog::Raster raster;
+    raster.cell_size = o.truth_resolution;
+    raster.box = wavog::CellBox{window.min_x, window.min_y, window.min_x + window.width,
+                                window.min_y + window.height};
+    raster.log_odds.resize(occ.size());
+    raster.known.assign(occ.size(), 1);
+    for (std::size_t i = 0; i < occ.size(); ++i) raster.log_odds[i] = occ[i] ? 20.0f : -20.0f;
+    std::ostringstream base;
+    base << o.truth_dir << "/truth_" << std::setw(4) << std::setfill('0')
+         << static_cast<int>(std::lround(t)) << "s";
+    wavog::writePng(base.str() + ".png", wavog::renderGrey(raster));
+    wavog::writeMapServerMap(base.str(), raster);
+  }
+}
+
+int run(const Options& o) {
+  World world = o.world_file.empty() ? wavog::sim::defaultWorld()
+                                     : wavog::sim::loadWorld(o.world_file);
+  if (o.duration > 0.0) world.duration = o.duration;
+  for (LaserParams& l : world.vehicle.lasers) {
+    if (o.noise_sigma >= 0.0) l.noise_sigma = o.noise_sigma;
+    if (o.dropout >= 0.0) l.dropout_prob = o.dropout;
+  }
+  if (!o.write_world.empty()) std::ofstream(o.write_world) << wavog::sim::worldToYaml(world);
+
+  wavog::sim::ScanSimulator sim(world, o.seed);
+  const std::size_t total = sim.scanCount();
+  rosbag::Bag bag(o.bag, rosbag::bagmode::Write);
+
+  const ros::Time t0(kEpoch);
+  tf2_msgs::TFMessage statics;
+  for (const LaserParams& l : world.vehicle.lasers) {
+    statics.transforms.push_back(transformMsg(o.base_frame, l.frame_id, l.mount, t0));
+  }
+  // Latched, so that `rosbag play` re-latches it. A custom connection header replaces rosbag's
+  // own, so it carries the type fields as well.
+  auto latched = boost::make_shared<ros::M_string>();
+  (*latched)["type"] = ros::message_traits::datatype<tf2_msgs::TFMessage>();
+  (*latched)["md5sum"] = ros::message_traits::md5sum<tf2_msgs::TFMessage>();
+  (*latched)["message_definition"] = ros::message_traits::definition<tf2_msgs::TFMessage>();
+  (*latched)["latching"] = "1";
+  (*latched)["callerid"] = "/wavog_simulate";
+  bag.write("/tf_static", t0, statics, latched);
+
+  std::vector<std::size_t> per_laser(world.vehicle.lasers.size(), 0);
+  SimScan scan;
+  std::size_t done = 0;
+  while (sim.next(&scan)) {
+    const ros::Time stamp = t0 + ros::Duration(scan.stamp);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame, scan.vehicle_pose, stamp));
+    bag.write("/tf", stamp, tf);
+    const LaserParams& laser = world.vehicle.lasers[static_cast<std::size_t>(scan.laser)];
+    bag.write(absoluteTopic(laser.topic), stamp, scanMsg(scan, laser, stamp));
+    ++per_laser[static_cast<std::size_t>(scan.laser)];
+    if (++done % 2000 == 0) std::cerr << "\rwavog_simulate: " << done << " / " << total << " scans";
+  }
+  // One more pose after the last scan, so a tf lookup at the last stamp never extrapolates.
+  const ros::Time end = t0 + ros::Duration(world.duration);
+  tf2_msgs::TFMessage tf;
+  tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame,
+                                       world.vehicle.path.at(world.duration), end));
+  bag.write("/tf", end, tf);
+  bag.close();
+
+  std::cerr << "\rwavog_simulate: world '" << world.name << "', seed " << o.seed << ", "
+            << world.duration << " s: wrote " << o.bag << " with";
+  for (std::size_t i = 0; i < per_laser.size(); ++i) {
+    std::cerr << (i ? ", " : " ") << per_laser[i] << " on "
+              << absoluteTopic(world.vehicle.lasers[i].topic);
+  }
+  std::cerr << ", " << done + 1 << " on /tf (" << o.map_frame << " -> " << o.base_frame
+            << "), 1 on /tf_static\n";
+  if (!o.truth_dir.empty()) {
+    writeTruth(world, o);
+    std::cerr << "wavog_simulate: ground truth in " << o.truth_dir << "/\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(parseArgs(argc, argv));
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "wavog_simulate: " << e.what() << "\n";
+    usage(std::cerr);
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "wavog_simulate: " << e.what() << "\n";
+    return 1;
+  }
+}
