@@ -35,5 +35,37 @@ if(CATKIN_ENABLE_TESTING)
     target_link_libraries(test_ros_config wavog_ros_config ${GTEST_MAIN_LIBRARIES})
     target_compile_definitions(test_ros_config PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
   endif()
-  include(cmake/ros_tests.cmake OPTIONAL)
+  if(TARGET wavog_mapping_node)
+    find_package(rostest REQUIRED)
+    find_package(roslaunch REQUIRED)
+    set(WAVOG_ROS_RUNTIME wavog_mapping_node wavog_mapping_nodelet)
+
+    # Integration: the same gtest against the node and against the nodelet, plus hztests.
+    add_rostest_gtest(test_mapping_system test/mapping_node.test test/ros/test_mapping_system.cpp)
+    target_include_directories(test_mapping_system SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(test_mapping_system ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_mapping_system ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    add_rostest(test/mapping_nodelet.test DEPENDENCIES test_mapping_system)
+
+    # Bad inputs: every malformed scan counted by reason, the node stays up.
+    if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_bad_input.cpp)
+      add_rostest_gtest(test_bad_input test/bad_input.test test/ros/test_bad_input.cpp)
+      target_include_directories(test_bad_input SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+      target_link_libraries(test_bad_input ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+      add_dependencies(test_bad_input ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    endif()
+
+    # Services: reset, clear_region, save_map + restart with map_file, corrupted map_file.
+    if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_services.cpp)
+      add_rostest_gtest(test_services test/services.test test/ros/test_services.cpp)
+      target_include_directories(test_services SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+      target_link_libraries(test_services ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+      add_dependencies(test_services ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+      target_compile_definitions(test_services PRIVATE
+        WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
+    endif()
+
+    # Every launch file parses and names existing nodes.
+    roslaunch_add_file_check(launch IGNORE_UNSET_ARGS DEPENDENCIES ${WAVOG_ROS_RUNTIME})
+  endif()
 endif()

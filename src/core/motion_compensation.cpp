@@ -2,6 +2,7 @@
 // transform into the reference frame, one bin lookup; no allocation once the buffers have grown.
 #include "wavog_mapping/core/motion_compensation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -24,6 +25,19 @@ Pose2 interpolate(const Pose2& a, const Pose2& b, double f) {
   p.y = a.y + f * (b.y - a.y);
   p.theta = wrap(a.theta + f * wrap(b.theta - a.theta));
   return p;
+}
+
+double scanReach(const ScanView& scan, const SensorModelParams& sensor, double resolution) {
+  const double range_max =
+      sensor.max_range > 0.0 ? std::min(sensor.max_range, scan.range_max) : scan.range_max;
+  double reach = 0.0;
+  for (std::size_t i = 0; i < scan.count; ++i) {
+    const double r = static_cast<double>(scan.ranges[i]);
+    if (std::isnan(r) || r <= 0.0 || r < scan.range_min) continue;  // no information
+    reach = std::max(reach, r >= range_max ? sensor.no_return_clear : r);
+  }
+  if (reach <= 0.0) return 0.0;
+  return reach + std::max(sensor.band_width, resolution) + resolution;
 }
 
 ScanView MotionCompensator::compensate(const ScanView& scan, const Pose2& start, const Pose2& end,

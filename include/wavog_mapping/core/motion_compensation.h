@@ -1,4 +1,4 @@
-// Motion compensation of one planar sweep: beams measured while the sensor moved are re-expressed
+// Motion compensation of one planar sweep (and the reach of a scan): beams measured while the sensor moved are re-expressed
 // in one reference pose and re-binned onto the scan's angular grid, so that the result can go to
 // WaveletMap::integrate(reference, view). Map frame, metres, radians. Not thread-safe (one
 // compensator per thread; it reuses its buffer).
@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/types.h"
 
 namespace wavog {
@@ -15,6 +16,11 @@ namespace wavog {
 /// Pose at fraction f of the way from a (f = 0) to b (f = 1): linear in position, along the
 /// shorter arc in heading.
 Pose2 interpolate(const Pose2& a, const Pose2& b, double f);
+
+/// Farthest distance (m) from the sensor at which `scan` can change the map under `sensor`: the
+/// longest return (plus the occupied band), or no_return_clear when a beam has no return. Used to
+/// bound the region a scan touched (e.g. for incremental map publication). 0 for an empty scan.
+double scanReach(const ScanView& scan, const SensorModelParams& sensor, double resolution);
 
 /// Re-bins moving-sensor scans. Beam i is assumed to be measured at fraction i / (count - 1) of the
 /// sweep (uniform time_increment), from the pose interpolated between `start` (beam 0) and `end`

@@ -1,0 +1,33 @@
+// MappingRos: the one class behind the nodelet and the node. Subscribes to 1-4 LaserScan topics
+// through tf2 MessageFilters, integrates every scan into one wavog::WaveletMap and publishes the
+// multiscale OccupancyGrid layers, map_updates, ~status and /diagnostics on timers; serves ~reset,
+// ~clear_region, ~save_map; dynamic_reconfigure for the policy, the publish rate and the scales.
+// Thread-safety: callbacks may run on several threads (MT node handles); ONE mutex (mutex_) guards
+// the map, the counters and everything else they share; tf2's buffer locks itself.
+#ifndef WAVOG_MAPPING_ROS_MAPPING_ROS_H_
+#define WAVOG_MAPPING_ROS_MAPPING_ROS_H_
+
+#include <memory>
+
+#include <ros/node_handle.h>
+
+namespace wavog_ros {
+
+class MappingRos {
+ public:
+  /// Reads the configuration from `pnh` (one loader, config.h), loads map_file, subscribes to the
+  /// inputs (topics relative to `nh`) and starts the timers. Throws std::invalid_argument naming
+  /// the bad parameter and its range, or std::runtime_error for an unreadable map_file.
+  MappingRos(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+  ~MappingRos();
+  MappingRos(const MappingRos&) = delete;
+  MappingRos& operator=(const MappingRos&) = delete;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace wavog_ros
+
+#endif  // WAVOG_MAPPING_ROS_MAPPING_ROS_H_

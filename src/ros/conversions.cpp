@@ -1,0 +1,120 @@
+// Message <-> core conversions (see conversions.h).
+#include "wavog_mapping/ros/conversions.h"
+
+#include <boost/make_shared.hpp>
+#include <cmath>
+
+#include <tf2/LinearMath/Matrix3x3.h>
+#include <tf2/LinearMath/Quaternion.h>
+
+namespace wavog_ros {
+
+const char* toString(DropReason reason) {
+  switch (reason) {
+    case DropReason::kEmpty:
+      return "empty";
+    case DropReason::kSizeMismatch:
+      return "size_mismatch";
+    case DropReason::kBadAngles:
+      return "bad_angles";
+    case DropReason::kBadFrame:
+      return "bad_frame";
+    case DropReason::kTfUnavailable:
+      return "tf_unavailable";
+    case DropReason::kTfTooOld:
+      return "tf_too_old";
+    case DropReason::kNoValidBeam:
+      return "no_valid_beam";
+    case DropReason::kBadGeometry:
+      return "bad_geometry";
+  }
+  return "unknown";
+}
+
+bool checkScan(const sensor_msgs::LaserScan& scan, DropReason* reason) {
+  const std::string& frame = scan.header.frame_id;
+  if (frame.empty() || frame[0] == '/') {
+    *reason = DropReason::kBadFrame;
+    return false;
+  }
+  const double inc = scan.angle_increment;
+  if (!std::isfinite(inc) || inc == 0.0 || !std::isfinite(scan.angle_min) ||
+      !std::isfinite(scan.angle_max)) {
+    *reason = DropReason::kBadAngles;
+    return false;
+  }
+  if (scan.ranges.empty()) {
+    *reason = DropReason::kEmpty;
+    return false;
+  }
+  // angle_max is the bearing of the last beam; drivers round it, so one beam of slack.
+  const double expected = (static_cast<double>(scan.angle_max) - scan.angle_min) / inc + 1.0;
+  if (std::abs(expected - static_cast<double>(scan.ranges.size())) > 1.01) {
+    *reason = DropReason::kSizeMismatch;
+    return false;
+  }
+  return true;
+}
+
+wavog::ScanView toScanView(const sensor_msgs::LaserScan& scan) {
+  wavog::ScanView v;
+  v.ranges = scan.ranges.data();
+  v.count = scan.ranges.size();
+  v.angle_min = scan.angle_min;
+  v.angle_increment = scan.angle_increment;
+  v.range_min = scan.range_min;
+  v.range_max = scan.range_max;
+  return v;
+}
+
+wavog::Pose2 toPose2(const geometry_msgs::Transform& transform, bool* mirrored) {
+  const tf2::Quaternion q(transform.rotation.x, transform.rotation.y, transform.rotation.z,
+                          transform.rotation.w);
+  const tf2::Matrix3x3 r(q);
+  wavog::Pose2 pose;
+  pose.x = transform.translation.x;
+  pose.y = transform.translation.y;
+  // Heading of the sensor's x axis projected on the map plane.
+  pose.theta = std::atan2(r[1][0], r[0][0]);
+  *mirrored = r[2][2] < 0.0;
+  return pose;
+}
+
+void mirrorView(wavog::ScanView* view) {
+  view->angle_min = -view->angle_min;
+  view->angle_increment = -view->angle_increment;
+}
+
+nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
+                                                const std::string& frame, const ros::Time& stamp) {
+  auto msg = boost::make_shared<nav_msgs::OccupancyGrid>();
+  msg->header.frame_id = frame;
+  msg->header.stamp = stamp;
+  msg->info.map_load_time = stamp;
+  msg->info.resolution = static_cast<float>(raster.cell_size);
+  msg->info.width = static_cast<std::uint32_t>(std::max<std::int64_t>(0, raster.box.width()));
+  msg->info.height = static_cast<std::uint32_t>(std::max<std::int64_t>(0, raster.box.height()));
+  msg->info.origin.position.x = raster.originX();
+  msg->info.origin.position.y = raster.originY();
+  msg->info.origin.orientation.w = 1.0;
+  msg->data = wavog::toOccupancyGrid(raster);
+  return msg;
+}
+
+map_msgs::OccupancyGridUpdate::Ptr toOccupancyGridUpdateMsg(const wavog::Raster& raster,
+                                                            std::int64_t grid_min_x,
+                                                            std::int64_t grid_min_y,
+                                                            const std::string& frame,
+                                                            const ros::Time& stamp) {
+  auto msg = boost::make_shared<map_msgs::OccupancyGridUpdate>();
+  msg->header.frame_id = frame;
+  msg->header.stamp = stamp;
+  msg->x = static_cast<std::int32_t>(raster.box.min_x - grid_min_x);
+  msg->y = static_cast<std::int32_t>(raster.box.min_y - grid_min_y);
+  msg->width = static_cast<std::uint32_t>(raster.box.width());
+  msg->height = static_cast<std::uint32_t>(raster.box.height());
+  msg->data = wavog::toOccupancyGrid(raster);
+  return msg;
+}
+
+}  // namespace wavog_ros

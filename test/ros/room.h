@@ -1,0 +1,129 @@
+// Synthetic test world shared by the rostests: a rectangular room, a robot with four LMS-291-like
+// scanners on its corners (one mounted upside down), static tf and ray-cast LaserScans.
+#ifndef WAVOG_MAPPING_TEST_ROS_ROOM_H_
+#define WAVOG_MAPPING_TEST_ROS_ROOM_H_
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2/LinearMath/Matrix3x3.h>
+#include <tf2/LinearMath/Quaternion.h>
+#include <tf2/LinearMath/Transform.h>
+
+namespace room {
+
+constexpr double kPi = 3.14159265358979323846;
+/// Walls: x = +-kHalfX, y = +-kHalfY (map frame, m); on cell centres of a 0.1 m grid.
+constexpr double kHalfX = 3.95;
+constexpr double kHalfY = 2.95;
+constexpr int kBeams = 361;
+
+struct Sensor {
+  std::string frame;
+  double x, y, yaw, roll;  // in base_link
+};
+
+inline const std::vector<Sensor>& sensors() {
+  static const std::vector<Sensor> kSensors = {
+      {"laser_1", 0.5, 0.4, kPi / 4, 0.0},
+      {"laser_2", 0.5, -0.4, -kPi / 4, kPi},  // upside down
+      {"laser_3", -0.5, 0.4, 3 * kPi / 4, 0.0},
+      {"laser_4", -0.5, -0.4, -3 * kPi / 4, 0.0},
+  };
+  return kSensors;
+}
+
+/// map -> base_link.
+inline tf2::Transform basePose() {
+  tf2::Quaternion q;
+  q.setRPY(0, 0, 0.1);
+  return tf2::Transform(q, tf2::Vector3(0.3, 0.2, 0.0));
+}
+
+inline tf2::Transform sensorInBase(const Sensor& s) {
+  tf2::Quaternion q;
+  q.setRPY(s.roll, 0, s.yaw);
+  return tf2::Transform(q, tf2::Vector3(s.x, s.y, 0.0));
+}
+
+inline geometry_msgs::TransformStamped toMsg(const tf2::Transform& t, const std::string& parent,
+                                             const std::string& child) {
+  geometry_msgs::TransformStamped m;
+  m.header.stamp = ros::Time::now();
+  m.header.frame_id = parent;
+  m.child_frame_id = child;
+  m.transform.translation.x = t.getOrigin().x();
+  m.transform.translation.y = t.getOrigin().y();
+  m.transform.translation.z = t.getOrigin().z();
+  m.transform.rotation.x = t.getRotation().x();
+  m.transform.rotation.y = t.getRotation().y();
+  m.transform.rotation.z = t.getRotation().z();
+  m.transform.rotation.w = t.getRotation().w();
+  return m;
+}
+
+/// The static tree: map -> base_link -> laser_1..4.
+inline std::vector<geometry_msgs::TransformStamped> staticTree() {
+  std::vector<geometry_msgs::TransformStamped> tree = {toMsg(basePose(), "map", "base_link")};
+  for (const auto& s : sensors()) tree.push_back(toMsg(sensorInBase(s), "base_link", s.frame));
+  return tree;
+}
+
+/// Distance from (ox, oy) along (dx, dy) to the room's walls.
+inline double castRay(double ox, double oy, double dx, double dy) {
+  double t = std::numeric_limits<double>::infinity();
+  if (dx > 1e-12) t = std::min(t, (kHalfX - ox) / dx);
+  if (dx < -1e-12) t = std::min(t, (-kHalfX - ox) / dx);
+  if (dy > 1e-12) t = std::min(t, (kHalfY - oy) / dy);
+  if (dy < -1e-12) t = std::min(t, (-kHalfY - oy) / dy);
+  return t;
+}
+
+/// The scan sensor `s` sees of the room (180 deg, 0.5 deg steps, LMS-291-like timing).
+inline sensor_msgs::LaserScan::Ptr scanOf(const Sensor& s, const ros::Time& stamp) {
+  auto scan = boost::make_shared<sensor_msgs::LaserScan>();
+  scan->header.frame_id = s.frame;
+  scan->header.stamp = stamp;
+  scan->angle_min = static_cast<float>(-kPi / 2);
+  scan->angle_increment = static_cast<float>(kPi / 360);
+  scan->angle_max = static_cast<float>(scan->angle_min + (kBeams - 1) * scan->angle_increment);
+  scan->time_increment = 1.0f / (75.0f * 360.0f);
+  scan->scan_time = 1.0f / 37.5f;
+  scan->range_min = 0.1f;
+  scan->range_max = 80.0f;
+  const tf2::Transform pose = basePose() * sensorInBase(s);
+  for (int i = 0; i < kBeams; ++i) {
+    const double a = scan->angle_min + i * static_cast<double>(scan->angle_increment);
+    const tf2::Vector3 d = tf2::Transform(pose.getRotation()) * tf2::Vector3(std::cos(a), std::sin(a), 0);
+    scan->ranges.push_back(static_cast<float>(
+        castRay(pose.getOrigin().x(), pose.getOrigin().y(), d.x(), d.y())));
+  }
+  return scan;
+}
+
+/// Value of the grid cell holding map point (x, y); -2 when outside the grid.
+inline int cellAt(const nav_msgs::OccupancyGrid& g, double x, double y) {
+  const double r = g.info.resolution;
+  const auto ix = static_cast<long>(std::floor((x - g.info.origin.position.x) / r));
+  const auto iy = static_cast<long>(std::floor((y - g.info.origin.position.y) / r));
+  if (ix < 0 || iy < 0 || ix >= static_cast<long>(g.info.width) ||
+      iy >= static_cast<long>(g.info.height)) {
+    return -2;
+  }
+  return g.data[static_cast<std::size_t>(iy) * g.info.width + static_cast<std::size_t>(ix)];
+}
+
+// Probe points (map frame).
+constexpr double kOccX = 3.95, kOccY = 0.05;    // on the wall x = +3.95
+constexpr double kFreeX = 0.05, kFreeY = -1.05;  // inside the room
+constexpr double kUnkX = -6.0, kUnkY = -6.0;     // outside the room
+
+}  // namespace room
+
+#endif  // WAVOG_MAPPING_TEST_ROS_ROOM_H_

@@ -1,0 +1,233 @@
+// Bad inputs: every malformed scan of the issue (REP 117 values, size mismatch, bad angles, empty,
+// empty / slashed / unknown frame, stamp too old for tf, time jumping backwards, bad range limits)
+// is counted by reason; the node stays up and keeps integrating; the map is unchanged where the
+// dropped scans would have changed it.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include "room.h"
+#include "wavog_mapping/MapperStatus.h"
+
+namespace {
+
+std::mutex g_mutex;
+nav_msgs::OccupancyGrid::ConstPtr g_map;
+wavog_mapping::MapperStatus::ConstPtr g_status;
+ros::Publisher g_scan_pub;
+
+nav_msgs::OccupancyGrid::ConstPtr lastMap() {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  return g_map;
+}
+wavog_mapping::MapperStatus::ConstPtr lastStatus() {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  return g_status;
+}
+
+/// Waits until `pred(status)` holds (or the timeout); returns the last status.
+template <typename Pred>
+wavog_mapping::MapperStatus::ConstPtr waitStatus(Pred pred, double timeout) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    auto s = lastStatus();
+    if (s && s->inputs.size() == 1 && pred(s->inputs[0])) return s;
+    ros::WallDuration(0.05).sleep();
+  }
+  return lastStatus();
+}
+
+/// A well-formed scan of laser_1 whose every beam sees a phantom wall at 1 m: integrating it
+/// would mark the free cell 1 m ahead of laser_1 occupied.
+sensor_msgs::LaserScan::Ptr phantom() {
+  auto scan = room::scanOf(room::sensors()[0], ros::Time::now());
+  std::fill(scan->ranges.begin(), scan->ranges.end(), 1.0f);
+  return scan;
+}
+
+/// Map point 1 m ahead of laser_1.
+void phantomPoint(double* x, double* y) {
+  const tf2::Transform pose = room::basePose() * room::sensorInBase(room::sensors()[0]);
+  const tf2::Vector3 p = pose * tf2::Vector3(1.0, 0.0, 0.0);
+  *x = p.x();
+  *y = p.y();
+}
+
+void publishGood(int n) {
+  for (int i = 0; i < n; ++i) {
+    g_scan_pub.publish(room::scanOf(room::sensors()[0], ros::Time::now()));
+    ros::WallDuration(0.1).sleep();
+  }
+}
+
+TEST(BadInput, EveryReasonCountedNodeStaysUpMapUnchanged) {
+  publishGood(5);
+  auto s = waitStatus([](const wavog_mapping::InputStatus& in) { return in.integrated >= 3; }, 20);
+  ASSERT_TRUE(s);
+  ASSERT_GE(s->inputs[0].integrated, 3u);
+  double px = 0, py = 0;
+  phantomPoint(&px, &py);
+  {
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(10);
+    while (ros::WallTime::now() < end &&
+           !(lastMap() && room::cellAt(*lastMap(), px, py) >= 0)) {
+      ros::WallDuration(0.05).sleep();
+    }
+  }
+  ASSERT_TRUE(lastMap());
+  const int before = room::cellAt(*lastMap(), px, py);
+  ASSERT_GE(before, 0);
+  ASSERT_LT(before, 35) << "the probe must be free before the bad scans";
+  const std::uint64_t integrated_before = s->inputs[0].integrated;
+
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+
+  auto empty = phantom();
+  empty->ranges.clear();
+  g_scan_pub.publish(empty);
+
+  auto size_mismatch = phantom();
+  size_mismatch->ranges.resize(100);
+  g_scan_pub.publish(size_mismatch);
+
+  auto zero_inc = phantom();
+  zero_inc->angle_increment = 0.0f;
+  g_scan_pub.publish(zero_inc);
+
+  auto nan_inc = phantom();
+  nan_inc->angle_increment = nan;
+  g_scan_pub.publish(nan_inc);
+
+  auto no_frame = phantom();
+  no_frame->header.frame_id = "";
+  g_scan_pub.publish(no_frame);
+
+  auto slash = phantom();
+  slash->header.frame_id = "/laser_1";
+  g_scan_pub.publish(slash);
+
+  auto all_nan = phantom();
+  std::fill(all_nan->ranges.begin(), all_nan->ranges.end(), nan);
+  g_scan_pub.publish(all_nan);
+
+  auto bad_limits = phantom();
+  bad_limits->range_min = 50.0f;
+  bad_limits->range_max = 10.0f;
+  g_scan_pub.publish(bad_limits);
+
+  auto too_old = phantom();
+  too_old->header.frame_id = "moving_laser";
+  too_old->header.stamp = ros::Time::now() - ros::Duration(60.0);
+  g_scan_pub.publish(too_old);
+  ros::WallDuration(0.2).sleep();
+
+  // Unknown frames wait in the tf queue (queue_size 2) until pushed out.
+  for (int i = 0; i < 4; ++i) {
+    auto unknown = phantom();
+    unknown->header.frame_id = "no_such_frame";
+    g_scan_pub.publish(unknown);
+    ros::WallDuration(0.02).sleep();
+  }
+  ros::WallDuration(0.2).sleep();
+
+  // REP 117 values inside a valid scan: used per beam, the scan is integrated.
+  auto rep117 = room::scanOf(room::sensors()[0], ros::Time::now());
+  rep117->ranges[0] = nan;
+  rep117->ranges[1] = inf;
+  rep117->ranges[2] = -inf;
+  rep117->ranges[3] = 0.01f;  // below range_min
+  g_scan_pub.publish(rep117);
+  ros::WallDuration(0.1).sleep();
+
+  // Time jumping backwards (as when a bag restarts): counted, and mapping goes on.
+  auto jumped = room::scanOf(room::sensors()[0], ros::Time::now() - ros::Duration(5.0));
+  g_scan_pub.publish(jumped);
+  ros::WallDuration(0.1).sleep();
+  publishGood(5);
+
+  s = waitStatus(
+      [&](const wavog_mapping::InputStatus& in) {
+        return in.integrated >= integrated_before + 7 && in.dropped_tf_unavailable >= 1 &&
+               in.dropped_tf_too_old >= 1;
+      },
+      20);
+  ASSERT_TRUE(s);
+  const auto& in = s->inputs[0];
+  EXPECT_EQ(in.dropped_empty, 1u);
+  EXPECT_EQ(in.dropped_size_mismatch, 1u);
+  EXPECT_EQ(in.dropped_bad_angles, 2u);
+  EXPECT_EQ(in.dropped_bad_frame, 2u);
+  EXPECT_EQ(in.dropped_no_valid_beam, 1u);
+  EXPECT_EQ(in.dropped_bad_geometry, 1u);
+  EXPECT_EQ(in.dropped_tf_too_old, 1u);
+  EXPECT_GE(in.dropped_tf_unavailable, 1u);
+  EXPECT_GE(in.time_jumps, 1u);
+  EXPECT_GE(in.beams_invalid, 3u);
+  EXPECT_GE(in.beams_no_return, 1u);
+  EXPECT_GE(in.integrated, integrated_before + 7);  // REP 117 scan, jumped scan, 5 good ones
+  EXPECT_EQ(s->tf_failures, in.dropped_tf_unavailable + in.dropped_tf_too_old);
+
+  // The map after the next publication: the phantom wall never made it in.
+  const ros::Time after = ros::Time::now();
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(10);
+  while (ros::WallTime::now() < end && !(lastMap() && lastMap()->header.stamp > after)) {
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_TRUE(lastMap());
+  const int after_value = room::cellAt(*lastMap(), px, py);
+  EXPECT_GE(after_value, 0);
+  EXPECT_LT(after_value, 35) << "a dropped scan changed the map";
+  EXPECT_GT(room::cellAt(*lastMap(), room::kOccX, room::kOccY), 65);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_bad_input");
+  ros::NodeHandle nh;
+  tf2_ros::StaticTransformBroadcaster static_tf;
+  static_tf.sendTransform(room::staticTree());
+  // A moving frame (dynamic tf at 20 Hz) for the stamp-too-old case.
+  tf2_ros::TransformBroadcaster tf;
+  std::atomic<bool> running{true};
+  std::thread tf_thread([&] {
+    ros::WallRate rate(20.0);
+    while (running && ros::ok()) {
+      tf.sendTransform(room::toMsg(room::sensorInBase(room::sensors()[0]), "base_link",
+                                   "moving_laser"));
+      rate.sleep();
+    }
+  });
+  g_scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 50);
+  auto map_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
+      "map", 2, [](const nav_msgs::OccupancyGrid::ConstPtr& g) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_map = g;
+      });
+  auto status_sub = nh.subscribe<wavog_mapping::MapperStatus>(
+      "wavog_mapping/status", 10, [](const wavog_mapping::MapperStatus::ConstPtr& s) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_status = s;
+      });
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  // Let the node subscribe before the first scan.
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20);
+  while (ros::WallTime::now() < end && g_scan_pub.getNumSubscribers() == 0) {
+    ros::WallDuration(0.05).sleep();
+  }
+  const int result = RUN_ALL_TESTS();
+  running = false;
+  tf_thread.join();
+  return result;
+}

@@ -1,0 +1,178 @@
+// Integration test, run against the node (mapping_node.test) and the nodelet
+// (mapping_nodelet.test): static tf, four synthetic scanners in a known room; asserts every
+// published layer's frame, resolution, size, origin, a known occupied, free and unknown cell, and
+// the status counters.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include "room.h"
+#include "wavog_mapping/MapperStatus.h"
+
+namespace {
+
+/// Expected geometry (test parameters: resolution 0.1, block_levels 6, scales 2 3 4): the room
+/// touches blocks -1 and 0 on each axis, so every layer covers [-6.4, 6.4)^2.
+constexpr double kResolution = 0.1;
+constexpr double kExtent = 12.8;
+constexpr double kOrigin = -6.4;
+
+class Recorder {
+ public:
+  void onGrid(const std::string& topic, const nav_msgs::OccupancyGrid::ConstPtr& g) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    grids_[topic] = g;
+  }
+  void onStatus(const wavog_mapping::MapperStatus::ConstPtr& s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    status_ = s;
+  }
+  nav_msgs::OccupancyGrid::ConstPtr grid(const std::string& topic) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return grids_[topic];
+  }
+  wavog_mapping::MapperStatus::ConstPtr status() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return status_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, nav_msgs::OccupancyGrid::ConstPtr> grids_;
+  wavog_mapping::MapperStatus::ConstPtr status_;
+};
+
+Recorder* g_recorder = nullptr;
+
+/// True once the layer shows the wall, i.e. scans have been integrated and published.
+bool layerReady(const nav_msgs::OccupancyGrid::ConstPtr& g) {
+  return g && g->info.width > 0 && room::cellAt(*g, room::kOccX, room::kOccY) > 65 &&
+         room::cellAt(*g, room::kFreeX, room::kFreeY) >= 0;
+}
+
+nav_msgs::OccupancyGrid::ConstPtr waitForLayer(const std::string& topic, double timeout) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    auto g = g_recorder->grid(topic);
+    if (layerReady(g)) return g;
+    ros::WallDuration(0.05).sleep();
+  }
+  return g_recorder->grid(topic);
+}
+
+void checkLayer(const std::string& topic, int scale) {
+  SCOPED_TRACE(topic);
+  const auto g = waitForLayer(topic, 30.0);
+  ASSERT_TRUE(g) << "nothing received on " << topic;
+  const double res = kResolution * (1 << scale);
+  EXPECT_EQ(g->header.frame_id, "map");
+  EXPECT_NEAR(g->info.resolution, res, 1e-6);
+  EXPECT_NEAR(g->info.width * res, kExtent, 1e-6);
+  EXPECT_NEAR(g->info.height * res, kExtent, 1e-6);
+  EXPECT_NEAR(g->info.origin.position.x, kOrigin, 1e-6);
+  EXPECT_NEAR(g->info.origin.position.y, kOrigin, 1e-6);
+  EXPECT_EQ(g->info.origin.orientation.w, 1.0);
+  ASSERT_EQ(g->data.size(), static_cast<std::size_t>(g->info.width) * g->info.height);
+  EXPECT_GT(room::cellAt(*g, room::kOccX, room::kOccY), 65) << "wall cell not occupied";
+  const int free_value = room::cellAt(*g, room::kFreeX, room::kFreeY);
+  EXPECT_GE(free_value, 0) << "free cell unknown";
+  EXPECT_LT(free_value, 35) << "free cell not free";
+  EXPECT_EQ(room::cellAt(*g, room::kUnkX, room::kUnkY), -1) << "cell outside the room not unknown";
+  for (std::int8_t v : g->data) {
+    ASSERT_TRUE(v == -1 || (v >= 0 && v <= 100)) << static_cast<int>(v);
+  }
+}
+
+TEST(MappingSystem, FinestLayer) { checkLayer("map", 0); }
+TEST(MappingSystem, Scale2) { checkLayer("map_scale_2", 2); }
+TEST(MappingSystem, Scale3) { checkLayer("map_scale_3", 3); }
+TEST(MappingSystem, Scale4) { checkLayer("map_scale_4", 4); }
+
+TEST(MappingSystem, StatusCounters) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(30.0);
+  wavog_mapping::MapperStatus::ConstPtr s;
+  while (ros::ok() && ros::WallTime::now() < end) {
+    s = g_recorder->status();
+    bool all = s && s->inputs.size() == 4;
+    for (std::size_t i = 0; all && i < s->inputs.size(); ++i) all = s->inputs[i].integrated >= 5;
+    if (all) break;
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_TRUE(s);
+  ASSERT_EQ(s->inputs.size(), 4u);
+  EXPECT_EQ(s->header.frame_id, "map");
+  std::uint64_t integrated = 0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto& in = s->inputs[i];
+    SCOPED_TRACE(in.topic);
+    EXPECT_EQ(in.topic, "/scan_" + std::to_string(i + 1));
+    EXPECT_GE(in.integrated, 5u);
+    EXPECT_GE(in.received, in.integrated);
+    EXPECT_EQ(in.dropped_empty + in.dropped_size_mismatch + in.dropped_bad_angles +
+                  in.dropped_bad_frame + in.dropped_tf_too_old + in.dropped_no_valid_beam +
+                  in.dropped_bad_geometry,
+              0u);
+    EXPECT_EQ(in.time_jumps, 0u);
+    EXPECT_EQ(in.motion_fallbacks, 0u);
+    EXPECT_GT(in.rate, 0.0);
+    EXPECT_EQ(in.expected_rate, 10.0);
+    integrated += in.integrated;
+  }
+  EXPECT_EQ(s->scans_integrated, integrated);
+  EXPECT_GT(s->nodes, 0u);
+  EXPECT_GT(s->bytes, 0u);
+  EXPECT_GE(s->integrate_time_max, s->integrate_time_mean);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_mapping_system");
+  ros::NodeHandle nh;
+  Recorder recorder;
+  g_recorder = &recorder;
+
+  tf2_ros::StaticTransformBroadcaster tf_broadcaster;
+  tf_broadcaster.sendTransform(room::staticTree());
+
+  std::vector<ros::Subscriber> subs;
+  for (const std::string topic : {"map", "map_scale_2", "map_scale_3", "map_scale_4"}) {
+    subs.push_back(nh.subscribe<nav_msgs::OccupancyGrid>(
+        topic, 2,
+        boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
+            [topic](const nav_msgs::OccupancyGrid::ConstPtr& g) { g_recorder->onGrid(topic, g); })));
+  }
+  subs.push_back(nh.subscribe("wavog_mapping/status", 10, &Recorder::onStatus, &recorder));
+
+  std::vector<ros::Publisher> pubs;
+  for (int i = 1; i <= 4; ++i) {
+    pubs.push_back(nh.advertise<sensor_msgs::LaserScan>("scan_" + std::to_string(i), 10));
+  }
+  std::atomic<bool> running{true};
+  std::thread publisher([&] {
+    ros::WallRate rate(10.0);
+    while (running && ros::ok()) {
+      const ros::Time stamp = ros::Time::now();
+      for (std::size_t i = 0; i < pubs.size(); ++i) {
+        pubs[i].publish(room::scanOf(room::sensors()[i], stamp));
+      }
+      rate.sleep();
+    }
+  });
+
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  running = false;
+  publisher.join();
+  spinner.stop();
+  return result;
+}
