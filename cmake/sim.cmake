@@ -20,7 +20,13 @@ function(wavog_sim_test name)
   set_tests_properties(sim_${name} PROPERTIES LABELS "sim" TIMEOUT 300)
 endfunction()
 
+# Policy evaluation through the core map (links wavog_core for real).
+add_library(wavog_sim_eval src/sim/evaluation.cpp)
+target_link_libraries(wavog_sim_eval PUBLIC wavog_sim wavog_core)
+target_compile_options(wavog_sim_eval PRIVATE ${WAVOG_WARNINGS})
+
 wavog_sim_test(test_simulator wavog_sim)
+wavog_sim_test(test_policy_response wavog_sim_eval)
 
 # ---- wavog_simulate: scenario -> rosbag (rosbag C++ API, no roscore) --------------------------
 set(WAVOG_SIM_BIN_DIR ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
