@@ -44,6 +44,9 @@ using Clock = std::chrono::steady_clock;
 
 /// Stamps (or the clock) going back by more than this (s) are a time jump (e.g. a bag restart).
 constexpr double kTimeJumpThreshold = 1.0;
+/// Subscriber queue per input: bursts (several drivers on one host) must not be lost before the
+/// scans reach the tf MessageFilter, whose own queue is the queue_size parameter.
+constexpr std::uint32_t kSubscriberQueue = 50;
 /// Seconds between two warnings of the same input and reason.
 constexpr double kWarnPeriod = 5.0;
 
@@ -227,7 +230,7 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
               onFilterFailure(raw, reason);
             }));
     in->sub = nh_.subscribe<LaserScan>(
-        ic.topic, static_cast<std::uint32_t>(ros.queue_size),
+        ic.topic, kSubscriberQueue,
         boost::function<void(const LaserScan::ConstPtr&)>(
             [this, raw](const LaserScan::ConstPtr& scan) { onScan(raw, scan); }),
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
@@ -316,21 +319,23 @@ void MappingRos::Impl::onScan(Input* in, const LaserScan::ConstPtr& scan) {
     ++in->c.received;
     ++in->c.received_in_period;
     in->c.last_receipt = now;
-    // A clock or stamp jumping backwards (bag restart, sensor reset): the tf buffer holds the old
+    // The clock jumping backwards (a bag restarted with --clock): the tf buffer holds the old
     // future and would refuse every new scan, so clear it and go on.
     if (!last_now_.isZero() && (last_now_ - now).toSec() > kTimeJumpThreshold) {
       ++clock_jumps_;
       clear_tf = true;
     }
     last_now_ = now;
+    // Stamps jumping backwards on one input (a bag restarted without --clock, a driver reset):
+    // counted and warned; such a scan is placed by tf if its stamp is still in the buffer, else
+    // dropped as too old.
     if (!in->c.last_received_stamp.isZero() &&
         (in->c.last_received_stamp - scan->header.stamp).toSec() > kTimeJumpThreshold) {
       ++in->c.time_jumps;
-      clear_tf = true;
       warnLocked(in, kNumDropReasons,
-                 "time jumped backwards by " +
+                 "stamp jumped backwards by " +
                      std::to_string((in->c.last_received_stamp - scan->header.stamp).toSec()) +
-                     " s: tf buffer cleared");
+                     " s");
     }
     in->c.last_received_stamp = scan->header.stamp;
     DropReason reason{};
@@ -343,7 +348,10 @@ void MappingRos::Impl::onScan(Input* in, const LaserScan::ConstPtr& scan) {
       return;
     }
   }
-  if (clear_tf) buffer_->clear();
+  if (clear_tf) {
+    ROS_WARN("%s: clock jumped backwards: tf buffer cleared", pnh_.getNamespace().c_str());
+    buffer_->clear();
+  }
   in->filter->add(scan);
 }
 
@@ -443,7 +451,8 @@ void MappingRos::Impl::onTransformable(Input* in, const LaserScan::ConstPtr& sca
       break;
     case wavog::ScanStatus::kBadGeometry:
     case wavog::ScanStatus::kBadPose:
-      dropLocked(in, DropReason::kBadGeometry, wavog::toString(st.status));
+      dropLocked(in, DropReason::kBadGeometry,
+                 std::string("refused by the core: ") + wavog::toString(st.status));
       break;
   }
 }
@@ -560,6 +569,7 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
       s.expected_rate = in->config.expected_rate;
       status->scans_integrated += c.integrated;
       status->tf_failures += s.dropped_tf_unavailable + s.dropped_tf_too_old;
+      status->clock_jumps = clock_jumps_;
       status->inputs.push_back(s);
     }
     last_mean_ = integrate_count_ > 0 ? integrate_time_sum_ / static_cast<double>(integrate_count_)

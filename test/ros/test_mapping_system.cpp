@@ -51,10 +51,12 @@ class Recorder {
 
 Recorder* g_recorder = nullptr;
 
-/// True once the layer shows the wall, i.e. scans have been integrated and published.
+/// True once the layer shows the room: with forgetting (gamma 0.3) a free cell needs a few scans
+/// to fall below 35.
 bool layerReady(const nav_msgs::OccupancyGrid::ConstPtr& g) {
-  return g && g->info.width > 0 && room::cellAt(*g, room::kOccX, room::kOccY) > 65 &&
-         room::cellAt(*g, room::kFreeX, room::kFreeY) >= 0;
+  if (!g || g->info.width == 0) return false;
+  const int free_value = room::cellAt(*g, room::kFreeX, room::kFreeY);
+  return room::cellAt(*g, room::kOccX, room::kOccY) > 65 && free_value >= 0 && free_value < 35;
 }
 
 nav_msgs::OccupancyGrid::ConstPtr waitForLayer(const std::string& topic, double timeout) {
