@@ -1,0 +1,341 @@
+// Tests of wavog_offline, run as a program: the map from a converted fr079 bag equals the core map
+// from the log read directly; the CARMEN log maps directly; outputs (PNG, PGM + YAML, native map,
+// summary.json, snapshots) are written and consistent; the real laser_scan_matcher_demo.bag (no tf,
+// frame "/laser") maps with --fixed-frame laser and its zero readings are rejected (REP 117); clear
+// errors for a missing file, a missing topic and tf that never connects.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2/buffer_core.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "wavog_mapping/core/wavelet_map.h"
+#include "wavog_mapping/io/carmen_reader.h"
+#include "wavog_mapping/io/image_io.h"
+#include "wavog_mapping/ros/config.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kScans = 300;
+
+struct RunResult {
+  int status = -1;
+  std::string err;
+};
+
+fs::path workDir() {
+  static const fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("wavog_offline_test_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+std::string readText(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+RunResult run(const std::string& program, const std::string& args) {
+  const fs::path err = workDir() / "stderr.txt";
+  const std::string cmd = program + " " + args + " 2> " + err.string();
+  RunResult r;
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.err = readText(err);
+  return r;
+}
+
+std::string dataFile(const std::string& name) {
+  const std::string dir = wavog::findDataDir(WAVOG_SOURCE_DIR);
+  return dir.empty() ? "" : (fs::path(dir) / name).string();
+}
+
+/// Compiled defaults, through the same loader as the tool.
+wavog::MapParams defaultParams() {
+  XmlRpc::XmlRpcValue empty;
+  return wavog_ros::configFromXmlRpc(empty, nullptr).map;
+}
+
+struct MapDiff {
+  std::size_t cells = 0;           ///< cells compared (union of both maps' bounds)
+  std::size_t known_mismatch = 0;  ///< observed in one map only
+  std::size_t value_mismatch = 0;  ///< observed in both, |difference| > 1e-4 * max(1, |value|)
+  double max_diff = 0.0;
+};
+
+MapDiff compare(const wavog::WaveletMap& a, const wavog::WaveletMap& b) {
+  MapDiff d;
+  wavog::CellBox ba;
+  wavog::CellBox bb;
+  if (!a.bounds(0, &ba) || !b.bounds(0, &bb)) return d;
+  const wavog::CellBox box{std::min(ba.min_x, bb.min_x), std::min(ba.min_y, bb.min_y),
+                           std::max(ba.max_x, bb.max_x), std::max(ba.max_y, bb.max_y)};
+  const wavog::Raster ra = a.exportScale(0, box, wavog::Aggregation::kMean);
+  const wavog::Raster rb = b.exportScale(0, box, wavog::Aggregation::kMean);
+  d.cells = ra.log_odds.size();
+  for (std::size_t i = 0; i < d.cells; ++i) {
+    if (ra.known[i] != rb.known[i]) {
+      ++d.known_mismatch;
+    } else if (ra.known[i]) {
+      const double diff = std::fabs(static_cast<double>(ra.log_odds[i]) - rb.log_odds[i]);
+      d.max_diff = std::max(d.max_diff, diff);
+      if (diff > 1e-4 * std::max(1.0, std::fabs(static_cast<double>(ra.log_odds[i])))) {
+        ++d.value_mismatch;
+      }
+    }
+  }
+  return d;
+}
+
+class OfflineFr079 : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    log_ = dataFile("fr079-corrected.log.gz");
+    if (log_.empty()) return;
+    bag_ = (workDir() / "fr079_300.bag").string();
+    const RunResult c = run(WAVOG_LOG2BAG, "--quiet --max-scans 300 " + log_ + " " + bag_);
+    ASSERT_EQ(c.status, 0) << c.err;
+    out_ = (workDir() / "fr079_bag").string();
+    bag_run_ = run(WAVOG_OFFLINE, "--no-progress --snapshot-every 5 --scale 0,2 -o " + out_ + " " +
+                                      bag_);
+  }
+
+  static std::string log_;
+  static std::string bag_;
+  static std::string out_;
+  static RunResult bag_run_;
+};
+std::string OfflineFr079::log_;
+std::string OfflineFr079::bag_;
+std::string OfflineFr079::out_;
+RunResult OfflineFr079::bag_run_;
+
+TEST_F(OfflineFr079, BagMapEqualsTheCoreMapFromTheLog) {
+  ASSERT_FALSE(log_.empty()) << "shared data not found: set WAVOG_DATA_DIR";
+  ASSERT_EQ(bag_run_.status, 0) << bag_run_.err;
+  const wavog::MapParams params = defaultParams();
+  wavog::WaveletMap from_bag(params);
+  from_bag.load((fs::path(out_) / "map.wavog").string());
+
+  // The core map from the log read directly (logged poses and angles).
+  wavog::WaveletMap direct(params);
+  const std::vector<wavog::CarmenScan> logged = wavog::readCarmenLog(log_, kScans);
+  for (const wavog::CarmenScan& scan : logged) direct.integrate(scan.laser_pose, scan.view(0.0));
+
+  // The same scans as the bag carries them: the LaserScan messages (float32 angles, +inf for no
+  // return) placed by a tf2::BufferCore filled from the bag (headings through quaternions).
+  wavog::WaveletMap via_tf(params);
+  double max_dxy = 0.0;
+  double max_dtheta = 0.0;
+  {
+    rosbag::Bag bag(bag_, rosbag::bagmode::Read);
+    tf2::BufferCore tf(ros::Duration(3600.0));
+    for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+      if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
+        for (const auto& t : msg->transforms) tf.setTransform(t, "test", m.getTopic() == "/tf_static");
+      }
+    }
+    std::size_t i = 0;
+    for (const rosbag::MessageInstance& m :
+         rosbag::View(bag, rosbag::TopicQuery("/front_laser/scan"))) {
+      const auto scan = m.instantiate<sensor_msgs::LaserScan>();
+      ASSERT_TRUE(scan);
+      ASSERT_LT(i, logged.size());
+      const auto t = tf.lookupTransform("map", scan->header.frame_id, scan->header.stamp);
+      const auto& q = t.transform.rotation;
+      const wavog::Pose2 pose{t.transform.translation.x, t.transform.translation.y,
+                              std::atan2(2.0 * (q.x * q.y + q.z * q.w),
+                                         1.0 - 2.0 * (q.y * q.y + q.z * q.z))};
+      max_dxy = std::max(max_dxy, std::hypot(pose.x - logged[i].laser_pose.x,
+                                             pose.y - logged[i].laser_pose.y));
+      max_dtheta = std::max(max_dtheta, std::fabs(std::remainder(
+                                            pose.theta - logged[i].laser_pose.theta, 2 * M_PI)));
+      wavog::ScanView view;
+      view.ranges = scan->ranges.data();
+      view.count = scan->ranges.size();
+      view.angle_min = scan->angle_min;
+      view.angle_increment = scan->angle_increment;
+      view.range_min = scan->range_min;
+      view.range_max = scan->range_max;
+      via_tf.integrate(pose, view);
+      ++i;
+    }
+    ASSERT_EQ(i, kScans);
+  }
+  EXPECT_LT(max_dxy, 1e-12);
+  EXPECT_LT(max_dtheta, 1e-12);
+  const MapDiff exact = compare(via_tf, from_bag);
+  EXPECT_EQ(exact.known_mismatch + exact.value_mismatch, 0u)
+      << exact.known_mismatch << " known, " << exact.value_mismatch << " value mismatches";
+  const MapDiff d = compare(direct, from_bag);
+  EXPECT_GT(d.cells, 100000u);
+  // Against the map of the logged values, the round-off of those two conversions (~1e-16 rad)
+  // may flip a rare cell that lies on a classification boundary, nothing more.
+  EXPECT_LE(d.known_mismatch + d.value_mismatch, d.cells / 100000) << "cells " << d.cells
+      << " known mismatch " << d.known_mismatch << " value mismatch " << d.value_mismatch;
+  RecordProperty("cells", static_cast<int>(d.cells));
+  RecordProperty("mismatch", static_cast<int>(d.known_mismatch + d.value_mismatch));
+  std::cout << "offline(bag) vs core(log): " << d.cells << " cells, " << d.known_mismatch
+            << " known mismatches, " << d.value_mismatch << " value mismatches (max diff "
+            << d.max_diff << "); vs core(log as the bag carries it): "
+            << exact.known_mismatch + exact.value_mismatch << " mismatches\n";
+}
+
+TEST_F(OfflineFr079, WritesPicturesMapServerFilesSummaryAndSnapshots) {
+  ASSERT_FALSE(log_.empty());
+  ASSERT_EQ(bag_run_.status, 0) << bag_run_.err;
+  const fs::path out(out_);
+  for (const char* f : {"map_s0.png", "map_s0.pgm", "map_s0.yaml", "map_s2.png", "map_s2.pgm",
+                        "map_s2.yaml", "map.wavog", "summary.json"}) {
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  }
+  EXPECT_FALSE(fs::exists(out / "map_s3.png"));  // --scale 0,2 overrides publish_scales
+  const wavog::Image png = wavog::readPng((out / "map_s0.png").string());
+  const wavog::Image pgm = wavog::readPgm((out / "map_s0.pgm").string());
+  EXPECT_EQ(png.channels, 3);
+  EXPECT_EQ(png.width, pgm.width);
+  EXPECT_EQ(png.height, pgm.height);
+  EXPECT_GT(png.width, 100);
+  const wavog::Image pgm2 = wavog::readPgm((out / "map_s2.pgm").string());
+  EXPECT_NEAR(pgm2.width, pgm.width / 4.0, 3.0);
+  const std::string yaml = readText(out / "map_s0.yaml");
+  EXPECT_NE(yaml.find("image: map_s0.pgm\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("resolution: 0.05"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("negate: 0\n"), std::string::npos) << yaml;
+  const std::string json = readText(out / "summary.json");
+  for (const char* key :
+       {"\"scans_integrated\": 300", "\"scans_dropped\": 0", "\"input_type\": \"bag\"",
+        "\"topics\": [\"/front_laser/scan\"]", "\"wall_time_s\"", "\"scans_per_s\"",
+        "\"bytes_per_observed_cell\"", "\"nodes\"", "\"policy\": \"forget\"", "\"snapshots\": [\"snapshots/"}) {
+    EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
+  }
+  // 300 scans of fr079 span about 64 s of log time: snapshots at 0, 5, 10, ... s.
+  std::size_t snapshots = 0;
+  for (const auto& e : fs::directory_iterator(out / "snapshots")) snapshots += e.path().extension() == ".png";
+  EXPECT_GE(snapshots, 10u);
+  EXPECT_TRUE(fs::exists(out / "snapshots" / "t00000.0_s0.png"));
+}
+
+TEST_F(OfflineFr079, CarmenLogDirectlyWithPolicyAndScaleOptions) {
+  ASSERT_FALSE(log_.empty());
+  const std::string out = (workDir() / "fr079_log").string();
+  const RunResult r = run(WAVOG_OFFLINE, "--no-progress --max-scans 300 --policy clamp --scale 1 "
+                                         "--aggregation max -o " + out + " " + log_);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string json = readText(fs::path(out) / "summary.json");
+  EXPECT_NE(json.find("\"input_type\": \"carmen\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"policy\": \"clamp\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"aggregation\": \"max\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"scans_integrated\": 300"), std::string::npos) << json;
+  EXPECT_TRUE(fs::exists(fs::path(out) / "map_s1.png"));
+  EXPECT_FALSE(fs::exists(fs::path(out) / "map_s0.png"));
+  // The native map is the clamp policy's map of the same scans.
+  wavog::MapParams params = wavog::MapParams::defaultsFor(wavog::PolicyType::kClamp);
+  wavog::WaveletMap loaded(params);
+  loaded.load((fs::path(out) / "map.wavog").string());
+  wavog::WaveletMap direct(params);
+  for (const wavog::CarmenScan& scan : wavog::readCarmenLog(log_, kScans)) {
+    direct.integrate(scan.laser_pose, scan.view(0.0));
+  }
+  const MapDiff d = compare(direct, loaded);
+  EXPECT_EQ(d.known_mismatch + d.value_mismatch, 0u) << d.known_mismatch << " " << d.value_mismatch;
+}
+
+TEST(Offline, LaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) {
+  const std::string bag = dataFile("laser_scan_matcher_demo.bag");
+  ASSERT_FALSE(bag.empty()) << "shared data not found: set WAVOG_DATA_DIR";
+  // Without tf the default fixed frame "map" never connects: a clear error listing the frames.
+  const std::string out = (workDir() / "lsm").string();
+  RunResult r = run(WAVOG_OFFLINE, "--no-progress -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("tf never connects the scan frame 'laser' to the fixed frame 'map'"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the bag has no /tf or /tf_static"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--fixed-frame"), std::string::npos) << r.err;
+
+  r = run(WAVOG_OFFLINE, "--no-progress --fixed-frame laser -o " + out + " " + bag);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Count the bag's invalid readings: zeros (Hokuyo error codes) and those below range_min.
+  std::uint64_t invalid = 0;
+  std::uint64_t zeros = 0;
+  std::uint64_t total = 0;
+  {
+    rosbag::Bag b(bag, rosbag::bagmode::Read);
+    for (const rosbag::MessageInstance& m : rosbag::View(b)) {
+      const auto scan = m.instantiate<sensor_msgs::LaserScan>();
+      if (!scan) continue;
+      EXPECT_EQ(scan->header.frame_id, "/laser");
+      for (float x : scan->ranges) {
+        ++total;
+        zeros += x == 0.0f ? 1 : 0;
+        invalid += (std::isnan(x) || x <= 0.0f || x < scan->range_min) ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(zeros, total / 50);  // about 5 %
+  const std::string json = readText(fs::path(out) / "summary.json");
+  EXPECT_NE(json.find("\"scans_integrated\": 360"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"invalid\": " + std::to_string(invalid) + "}"), std::string::npos)
+      << "expected " << invalid << " invalid beams (" << zeros << " zeros)\n" << json;
+  EXPECT_NE(json.find("\"fixed_frame\": \"laser\""), std::string::npos) << json;
+  // No cell at the laser's own position is occupied: zero readings never became hits.
+  wavog::WaveletMap map(defaultParams());
+  map.load((fs::path(out) / "map.wavog").string());
+  EXPECT_LE(map.value(map.cellAt(0.0, 0.0)), 0.0f);
+}
+
+TEST(Offline, ClearErrors) {
+  const std::string out = (workDir() / "errors").string();
+  const std::string missing = (workDir() / "missing.bag").string();
+  RunResult r = run(WAVOG_OFFLINE, "--no-progress -o " + out + " " + missing);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find(missing + ": cannot open"), std::string::npos) << r.err;
+
+  const std::string bag = dataFile("laser_scan_matcher_demo.bag");
+  ASSERT_FALSE(bag.empty());
+  r = run(WAVOG_OFFLINE, "--no-progress --topics front_laser/scan -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("the bag has no topic 'front_laser/scan'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/scan (sensor_msgs/LaserScan, 360 msgs)"), std::string::npos) << r.err;
+
+  r = run(WAVOG_OFFLINE, "--no-progress --policy sometimes -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("policy"), std::string::npos) << r.err;
+
+  const std::string yaml = (workDir() / "bad.yaml").string();
+  std::ofstream(yaml) << "resolution: [1, 2\n";
+  r = run(WAVOG_OFFLINE, "--no-progress -c " + yaml + " -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find(yaml), std::string::npos) << r.err;
+
+  r = run(WAVOG_OFFLINE, "");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("Usage: wavog_offline"), std::string::npos) << r.err;
+}
+
+class Cleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(workDir(), ec);
+  }
+};
+const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new Cleanup);
+
+}  // namespace
