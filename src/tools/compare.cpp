@@ -669,13 +669,15 @@ std::string report(const std::vector<WorkloadResult>& results, const Options& op
        << fmt(s[kWavogForget].scans_per_s / s[kDense].scans_per_s, 2) << "x |\n";
   }
   os << "\n### Memory (bytes per observed cell: own account / resident-set growth)\n\n"
-     << "| workload | res | observed cells (clamp / OctoMap / dense) | wavog-clamp | wavog-forget | "
-        "OctoMap | dense | OctoMap/clamp (own) |\n"
-     << "|---|---|---|---|---|---|---|---|\n";
+     << "| workload | res | observed cells (clamp / OctoMap / dense) | own MB (clamp / forget / "
+        "OctoMap / dense) | wavog-clamp | wavog-forget | OctoMap | dense | OctoMap/clamp (own) |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
   for (const WorkloadResult& r : results) {
     const SubjectResult* s = r.subject;
     os << "| " << r.label << " | " << fmt(r.resolution * 100, 0) << " cm | "
        << s[kWavogClamp].observed << " / " << s[kOctoMap].observed << " / " << s[kDense].observed
+       << " | " << fmt(s[kWavogClamp].own_bytes / 1e6, 2) << " / " << fmt(s[kWavogForget].own_bytes / 1e6, 2)
+       << " / " << fmt(s[kOctoMap].own_bytes / 1e6, 2) << " / " << fmt(s[kDense].own_bytes / 1e6, 2)
        << " |";
     for (int k = 0; k < kSubjects; ++k) {
       os << " " << fmt(perCell(s[k].own_bytes, s[k].observed), 2) << " / "
@@ -685,6 +687,8 @@ std::string report(const std::vector<WorkloadResult>& results, const Options& op
                          perCell(s[kWavogClamp].own_bytes, s[kWavogClamp].observed), 1)
        << "x |\n";
   }
+  os << "\nObserved cells are each structure's own count: wavog's sector model observes the whole "
+        "field of view, rays only the cells they cross (fewer at long range).\n";
   os << "\n### Agreement (same class, occupied p > 0.5 / free p < 0.5, among cells all three "
         "observed)\n\n"
      << "| workload | res | common cells | clamp~OctoMap | clamp~dense | OctoMap~dense | "
