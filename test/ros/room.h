@@ -119,6 +119,13 @@ inline int cellAt(const nav_msgs::OccupancyGrid& g, double x, double y) {
   return g.data[static_cast<std::size_t>(iy) * g.info.width + static_cast<std::size_t>(ix)];
 }
 
+/// Map point `d` metres straight ahead of sensor `s`.
+inline void aheadOf(const Sensor& s, double d, double* x, double* y) {
+  const tf2::Vector3 p = basePose() * sensorInBase(s) * tf2::Vector3(d, 0.0, 0.0);
+  *x = p.x();
+  *y = p.y();
+}
+
 // Probe points (map frame).
 constexpr double kOccX = 3.95, kOccY = 0.05;    // on the wall x = +3.95
 constexpr double kFreeX = 0.05, kFreeY = -1.05;  // inside the room

@@ -54,12 +54,7 @@ sensor_msgs::LaserScan::Ptr phantom() {
 }
 
 /// Map point 1 m ahead of laser_1.
-void phantomPoint(double* x, double* y) {
-  const tf2::Transform pose = room::basePose() * room::sensorInBase(room::sensors()[0]);
-  const tf2::Vector3 p = pose * tf2::Vector3(1.0, 0.0, 0.0);
-  *x = p.x();
-  *y = p.y();
-}
+void phantomPoint(double* x, double* y) { room::aheadOf(room::sensors()[0], 1.0, x, y); }
 
 void publishGood(int n) {
   for (int i = 0; i < n; ++i) {

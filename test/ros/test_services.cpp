@@ -1,0 +1,227 @@
+// Services: ~clear_region clears only its box, ~reset empties the map, ~save_map writes the native
+// file and map_server images, and a node restarted with map_file publishes the same map. A
+// corrupted map_file and a bad parameter stop the node at start-up (exit 1) with a clear message.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <std_srvs/Empty.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include "room.h"
+#include "wavog_mapping/ClearRegion.h"
+#include "wavog_mapping/SaveMap.h"
+
+namespace {
+
+std::mutex g_mutex;
+nav_msgs::OccupancyGrid::ConstPtr g_map;
+nav_msgs::OccupancyGrid::ConstPtr g_restored;
+ros::Publisher g_scan_pub;
+
+nav_msgs::OccupancyGrid::ConstPtr get(const nav_msgs::OccupancyGrid::ConstPtr& which) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  return which;
+}
+
+/// The first `map` published after now (the publication timer runs at 5 Hz).
+nav_msgs::OccupancyGrid::ConstPtr nextMap(double timeout = 10.0) {
+  const ros::Time after = ros::Time::now();
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    auto g = get(g_map);
+    if (g && g->header.stamp > after) return g;
+    ros::WallDuration(0.02).sleep();
+  }
+  return nullptr;
+}
+
+bool exists(const std::string& path) {
+  struct stat st {};
+  return stat(path.c_str(), &st) == 0;
+}
+
+/// Runs a command, returns its exit status; *output gets stdout and stderr.
+int run(const std::string& command, std::string* output) {
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[4096];
+  while (fgets(buffer, sizeof(buffer), pipe)) *output += buffer;
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+const std::string kDir = "/tmp/wavog_test_services_" + std::to_string(getpid());
+const std::string kMapFile = kDir + "/room.wavog";
+
+/// Builds a map of the room from 10 scans of laser_1, then stops publishing.
+class Services : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    mkdir(kDir.c_str(), 0755);
+    for (int i = 0; i < 10; ++i) {
+      g_scan_pub.publish(room::scanOf(room::sensors()[0], ros::Time::now()));
+      ros::WallDuration(0.1).sleep();
+    }
+    ros::WallDuration(0.3).sleep();
+  }
+};
+
+TEST_F(Services, SaveMapWritesNativeAndMapServerFiles) {
+  const auto before = nextMap();
+  ASSERT_TRUE(before);
+  ASSERT_GT(room::cellAt(*before, room::kOccX, room::kOccY), 65);
+  wavog_mapping::SaveMap srv;
+  srv.request.path = kMapFile;
+  ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_TRUE(exists(kMapFile));
+  for (const char* s : {"0", "2", "3", "4"}) {
+    EXPECT_TRUE(exists(kDir + "/room_scale_" + s + ".pgm")) << s;
+    EXPECT_TRUE(exists(kDir + "/room_scale_" + s + ".yaml")) << s;
+  }
+  EXPECT_EQ(srv.response.files.size(), 9u);
+
+  // A node restarted with map_file publishes the same map (same geometry, same values).
+  std::string output;
+  const std::string cmd = std::string("timeout 5 ") + WAVOG_NODE_BIN +
+                          " __name:=restored map:=/restored/map scan_1:=/restored/scan" +
+                          " _map_file:=" + kMapFile;
+  ros::param::set("/restored/resolution", 0.1);
+  ros::param::set("/restored/block_levels", 6);
+  std::thread restored([&] { run(cmd, &output); });
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(8.0);
+  while (ros::WallTime::now() < end && !get(g_restored)) ros::WallDuration(0.05).sleep();
+  restored.join();
+  const auto again = get(g_restored);
+  ASSERT_TRUE(again) << output;
+  EXPECT_EQ(again->info.width, before->info.width);
+  EXPECT_EQ(again->info.height, before->info.height);
+  EXPECT_EQ(again->info.resolution, before->info.resolution);
+  EXPECT_EQ(again->info.origin.position.x, before->info.origin.position.x);
+  EXPECT_EQ(again->info.origin.position.y, before->info.origin.position.y);
+  EXPECT_TRUE(again->data == before->data) << "restored map differs";
+}
+
+TEST_F(Services, ClearRegionClearsOnlyTheBox) {
+  double fx = 0, fy = 0;  // a free cell seen by laser_1
+  room::aheadOf(room::sensors()[0], 1.5, &fx, &fy);
+  const auto before = nextMap();
+  ASSERT_TRUE(before);
+  ASSERT_GE(room::cellAt(*before, fx, fy), 0);
+  wavog_mapping::ClearRegion srv;
+  srv.request.min_x = fx - 0.3;
+  srv.request.min_y = fy - 0.3;
+  srv.request.max_x = fx + 0.3;
+  srv.request.max_y = fy + 0.3;
+  ASSERT_TRUE(ros::service::call("wavog_mapping/clear_region", srv));
+  EXPECT_TRUE(srv.response.success);
+  const auto after = nextMap();
+  ASSERT_TRUE(after);
+  EXPECT_EQ(room::cellAt(*after, fx, fy), -1);
+  // Outside the box nothing changed.
+  std::size_t changed_outside = 0;
+  for (std::uint32_t iy = 0; iy < after->info.height; ++iy) {
+    for (std::uint32_t ix = 0; ix < after->info.width; ++ix) {
+      const double x = after->info.origin.position.x + (ix + 0.5) * after->info.resolution;
+      const double y = after->info.origin.position.y + (iy + 0.5) * after->info.resolution;
+      const bool inside = x >= srv.request.min_x && x <= srv.request.max_x &&
+                          y >= srv.request.min_y && y <= srv.request.max_y;
+      const std::size_t k = iy * after->info.width + ix;
+      if (inside) {
+        EXPECT_EQ(after->data[k], -1);
+      } else if (after->data[k] != before->data[k]) {
+        ++changed_outside;
+      }
+    }
+  }
+  EXPECT_EQ(changed_outside, 0u);
+  // A box with min > max is refused.
+  srv.request.min_x = 1.0;
+  srv.request.max_x = 0.0;
+  ASSERT_TRUE(ros::service::call("wavog_mapping/clear_region", srv));
+  EXPECT_FALSE(srv.response.success);
+}
+
+TEST_F(Services, ResetEmptiesTheMap) {
+  std_srvs::Empty srv;
+  ASSERT_TRUE(ros::service::call("wavog_mapping/reset", srv));
+  const auto after = nextMap();
+  ASSERT_TRUE(after);
+  for (std::int8_t v : after->data) ASSERT_EQ(v, -1);
+}
+
+TEST_F(Services, CorruptedMapFileFailsAtStartUp) {
+  const std::string bad = kDir + "/corrupt.wavog";
+  {
+    std::ifstream in(kMapFile, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 64u);
+    bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x5a);
+    std::ofstream out(bad, std::ios::binary);
+    out << bytes;
+  }
+  ros::param::set("/corrupt/resolution", 0.1);
+  ros::param::set("/corrupt/block_levels", 6);
+  std::string output;
+  const int code = run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
+                           " __name:=corrupt map:=/corrupt/map _map_file:=" + bad,
+                       &output);
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find("map_file"), std::string::npos) << output;
+  EXPECT_NE(output.find(bad), std::string::npos) << output;
+}
+
+TEST_F(Services, BadParameterFailsAtStartUpNamingIt) {
+  std::string output;
+  const int code = run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
+                           " __name:=badparam map:=/badparam/map _publish_rate:=-2.0",
+                       &output);
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find("publish_rate (-2) must be in (0, 100] Hz"), std::string::npos) << output;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_services");
+  ros::NodeHandle nh;
+  tf2_ros::StaticTransformBroadcaster static_tf;
+  static_tf.sendTransform(room::staticTree());
+  g_scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 50);
+  auto map_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
+      "map", 2,
+      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
+          [](const nav_msgs::OccupancyGrid::ConstPtr& g) {
+            std::lock_guard<std::mutex> lock(g_mutex);
+            g_map = g;
+          }));
+  auto restored_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
+      "restored/map", 2,
+      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
+          [](const nav_msgs::OccupancyGrid::ConstPtr& g) {
+            std::lock_guard<std::mutex> lock(g_mutex);
+            if (!g_restored) g_restored = g;
+          }));
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20);
+  while (ros::WallTime::now() < end && g_scan_pub.getNumSubscribers() == 0) {
+    ros::WallDuration(0.05).sleep();
+  }
+  ros::service::waitForService("wavog_mapping/reset", ros::Duration(20));
+  const int result = RUN_ALL_TESTS();
+  std::string ignored;
+  run("rm -rf " + kDir, &ignored);
+  return result;
+}
