@@ -182,12 +182,19 @@ class Subject {
   virtual std::uint64_t observedCells() const = 0;
   /// Class of every cell of `box` (row-major, x fastest).
   virtual std::vector<std::uint8_t> classify(const wavog::CellBox& box) const = 0;
+  /// Work done so far by the structure's own count (nodes visited, cells updated); 0 if unknown.
+  std::uint64_t work() const { return work_; }
+
+ protected:
+  std::uint64_t work_ = 0;
 };
 
 class WavogSubject : public Subject {
  public:
   explicit WavogSubject(const wavog::MapParams& params) : map_(params) {}
-  void integrate(const Scan& scan) override { map_.integrate(scan.pose, scan.view()); }
+  void integrate(const Scan& scan) override {
+    work_ += map_.integrate(scan.pose, scan.view()).nodes_visited;
+  }
   std::size_t ownBytes() const override { return map_.stats().bytes; }
   std::uint64_t observedCells() const override { return map_.stats(true).observed_cells; }
   std::vector<std::uint8_t> classify(const wavog::CellBox& box) const override {
@@ -283,7 +290,9 @@ class OctoMapSubject : public Subject {
 class DenseSubject : public Subject {
  public:
   explicit DenseSubject(const wavog::baseline::DenseGridParams& params) : grid_(params) {}
-  void integrate(const Scan& scan) override { grid_.integrate(scan.pose, scan.view()); }
+  void integrate(const Scan& scan) override {
+    work_ += grid_.integrate(scan.pose, scan.view()).cells_updated;
+  }
   std::size_t ownBytes() const override { return grid_.bytes(); }
   std::uint64_t observedCells() const override { return grid_.countObserved(); }
   std::vector<std::uint8_t> classify(const wavog::CellBox& box) const override {
@@ -348,6 +357,7 @@ struct SubjectResult {
   std::size_t own_bytes = 0;
   std::size_t rss_growth = 0;
   std::uint64_t observed = 0;
+  double work_per_scan = 0.0;          ///< nodes visited / cells updated per scan (warm-up run)
 };
 
 struct PairAgreement {
@@ -549,6 +559,7 @@ WorkloadResult runWorkload(const Workload& wl, const Options& opt) {
     r.rss_growth = residentBytes() - std::min(rss0, residentBytes());
     r.own_bytes = full[k]->ownBytes();
     r.observed = full[k]->observedCells();
+    r.work_per_scan = static_cast<double>(full[k]->work()) / static_cast<double>(wl.scans.size());
     // Timed repetitions, each into a fresh structure; construction and destruction not timed.
     for (int rep = 0; rep < opt.reps; ++rep) {
       std::unique_ptr<Subject> m = make[k]();
@@ -667,6 +678,16 @@ std::string report(const std::vector<WorkloadResult>& results, const Options& op
        << fmt(s[kWavogClamp].scans_per_s / s[kDense].scans_per_s, 2) << "x | "
        << fmt(s[kWavogForget].scans_per_s / s[kOctoMap].scans_per_s, 1) << "x | "
        << fmt(s[kWavogForget].scans_per_s / s[kDense].scans_per_s, 2) << "x |\n";
+  }
+  os << "\nWork per scan (warm-up run): wavog nodes and finest cells visited (IntegrateStats::"
+        "nodes_visited), dense cells updated.\n\n"
+     << "| workload | res | wavog-clamp visits | wavog-forget visits | dense cells updated |\n"
+     << "|---|---|---|---|---|\n";
+  for (const WorkloadResult& r : results) {
+    os << "| " << r.label << " | " << fmt(r.resolution * 100, 0) << " cm | "
+       << fmt(r.subject[kWavogClamp].work_per_scan, 0) << " | "
+       << fmt(r.subject[kWavogForget].work_per_scan, 0) << " | "
+       << fmt(r.subject[kDense].work_per_scan, 0) << " |\n";
   }
   os << "\n### Memory (bytes per observed cell: own account / resident-set growth)\n\n"
      << "| workload | res | observed cells (clamp / OctoMap / dense) | own MB (clamp / forget / "
@@ -904,13 +925,14 @@ int main(int argc, char** argv) {
   md << text;
   std::ofstream csv(opt.out_dir + "/results.csv");
   csv << "workload,resolution_m,scans,timed_scans,structure,scans_per_s,rep_min_s,rep_max_s,"
-         "warmup_s,own_bytes,rss_growth_bytes,observed_cells\n";
+         "warmup_s,own_bytes,rss_growth_bytes,observed_cells,work_per_scan\n";
   for (const WorkloadResult& r : results) {
     for (int k = 0; k < kSubjects; ++k) {
       const SubjectResult& s = r.subject[k];
       csv << r.name << "," << r.resolution << "," << r.scans << "," << r.timed_scans << ","
           << kSubjectNames[k] << "," << s.scans_per_s << "," << s.min_s << "," << s.max_s << ","
-          << s.warmup_s << "," << s.own_bytes << "," << s.rss_growth << "," << s.observed << "\n";
+          << s.warmup_s << "," << s.own_bytes << "," << s.rss_growth << "," << s.observed << ","
+          << s.work_per_scan << "\n";
     }
   }
   if (!md || !csv) {
