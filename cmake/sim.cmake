@@ -36,3 +36,11 @@ target_link_libraries(wavog_simulate PRIVATE wavog_sim wavog_io ${catkin_LIBRARI
 target_compile_options(wavog_simulate PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_simulate PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_SIM_BIN_DIR})
 install(TARGETS wavog_simulate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+# ---- wavog_evaluate: every policy over a scenario against ground truth (no ROS at run time) ---
+add_executable(wavog_evaluate src/tools/evaluate.cpp src/sim/plot.cpp)
+target_include_directories(wavog_evaluate PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/sim)
+target_link_libraries(wavog_evaluate PRIVATE wavog_sim_eval wavog_io Threads::Threads)
+target_compile_options(wavog_evaluate PRIVATE ${WAVOG_WARNINGS})
+set_target_properties(wavog_evaluate PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_SIM_BIN_DIR})
+install(TARGETS wavog_evaluate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -12,6 +12,17 @@ namespace {
 constexpr double kFootprintStep = 0.01;  // time step when looking for a vacated footprint (s)
 constexpr int kMinHits = 2;              // true hits that make a cell part of an event
 
+// True if the centre of `cell` lies on a beam of `scan` at least one cell before its true hit:
+// the lasers saw it free.
+bool seenFree(const SimScan& scan, const LaserParams& l, const CellIndex& cell, double res) {
+  const double cx = (static_cast<double>(cell.x) + 0.5) * res - scan.sensor_pose.x;
+  const double cy = (static_cast<double>(cell.y) + 0.5) * res - scan.sensor_pose.y;
+  const double rel = wrapAngle(std::atan2(cy, cx) - scan.sensor_pose.theta - l.angleMin());
+  const double beam = std::round(rel / l.angleIncrement());
+  if (beam < 0 || beam >= l.beams) return false;
+  return scan.true_ranges[static_cast<std::size_t>(beam)] > std::hypot(cx, cy) + res;
+}
+
 double probability(float log_odds) { return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds))); }
 
 // Time at which a departing object starts to move: the end of its first constant stretch.
@@ -41,6 +52,22 @@ std::vector<std::uint8_t> dilate(const std::vector<std::uint8_t>& mask, const Gr
     }
   }
   return out;
+}
+
+// True if a beam of `scan` truly hits `object` inside `cell`.
+bool hitsCell(const SimScan& scan, const LaserParams& l, int object, const CellIndex& cell,
+              double res) {
+  for (std::size_t b = 0; b < scan.hit_object.size(); ++b) {
+    if (scan.hit_object[b] != object) continue;
+    const double bearing = scan.sensor_pose.theta + l.angleMin() + b * l.angleIncrement();
+    const double x = scan.sensor_pose.x + scan.true_ranges[b] * std::cos(bearing);
+    const double y = scan.sensor_pose.y + scan.true_ranges[b] * std::sin(bearing);
+    if (static_cast<std::int64_t>(std::floor(x / res)) == cell.x &&
+        static_cast<std::int64_t>(std::floor(y / res)) == cell.y) {
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
@@ -107,6 +134,25 @@ std::vector<WorldEvent> findEvents(const World& world, const std::vector<SimScan
     for (const auto& [cell, n] : hits) {
       if (n >= kMinHits) e.cells.push_back(CellIndex{cell.first, cell.second});
     }
+    // First scan after the event that observes each cell: sees it free (departure) or hits it
+    // (arrival). Cells never observed again say nothing about the map and are dropped.
+    std::vector<CellIndex> kept;
+    for (const CellIndex& c : e.cells) {
+      for (std::size_t j = 0; j < scans.size(); ++j) {
+        const SimScan& s = scans[j];
+        if (s.stamp < e.event_time) continue;
+        const LaserParams& l = world.vehicle.lasers[static_cast<std::size_t>(s.laser)];
+        const bool observed = e.type == WorldEvent::Type::kDeparture
+                                  ? seenFree(s, l, c, resolution)
+                                  : hitsCell(s, l, e.object, c, resolution);
+        if (observed) {
+          kept.push_back(c);
+          e.first_view.push_back(j);
+          break;
+        }
+      }
+    }
+    e.cells.swap(kept);
     events.push_back(e);
   }
   return events;
@@ -121,14 +167,9 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
   result.events.resize(events.size());
   WaveletMap map(run.params);
 
-  // Share of an event's cells that have switched (freed or occupied).
-  auto switched = [&map](const WorldEvent& e) {
-    std::size_t n = 0;
-    for (const CellIndex& c : e.cells) {
-      const float v = map.value(c);
-      n += e.type == WorldEvent::Type::kDeparture ? v < 0.0f : v > 0.0f;
-    }
-    return e.cells.empty() ? 0.0 : static_cast<double>(n) / static_cast<double>(e.cells.size());
+  auto has_switched = [&map](const WorldEvent& e, const CellIndex& c) {
+    const float v = map.value(c);
+    return e.type == WorldEvent::Type::kDeparture ? v < 0.0f : v > 0.0f;
   };
   auto mean_occupancy = [&map](const WorldEvent& e) {
     double sum = 0.0;
@@ -136,15 +177,19 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
     return e.cells.empty() ? 0.0 : sum / static_cast<double>(e.cells.size());
   };
 
-  std::vector<std::size_t> scans_since(events.size(), 0);
+  // Per event and cell: the scan index at which the cell switched (kNever: not yet).
+  constexpr std::size_t kNever = std::numeric_limits<std::size_t>::max();
+  std::vector<std::vector<std::size_t>> switched_at(events.size());
   std::vector<double> next_sample(events.size());
   for (std::size_t k = 0; k < events.size(); ++k) {
+    switched_at[k].assign(events[k].cells.size(), kNever);
     next_sample[k] = std::max(0.0, events[k].start_time - 2.0);
   }
   double total = 0.0;
   double worst = 0.0;
   using Clock = std::chrono::steady_clock;
-  for (const SimScan& s : scans) {
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    const SimScan& s = scans[i];
     const LaserParams& l = world.vehicle.lasers[static_cast<std::size_t>(s.laser)];
     const Clock::time_point t0 = Clock::now();
     map.integrate(s.sensor_pose, s.view(l));
@@ -154,20 +199,36 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
 
     for (std::size_t k = 0; k < events.size(); ++k) {
       const WorldEvent& e = events[k];
-      EventResponse& r = result.events[k];
-      if (s.stamp >= e.event_time && !r.reached()) {
-        ++scans_since[k];
-        if (switched(e) >= options.fraction) {
-          r.scans = scans_since[k];
-          r.seconds = s.stamp - e.event_time;
+      for (std::size_t c = 0; c < e.cells.size(); ++c) {
+        if (switched_at[k][c] == kNever && e.first_view[c] <= i && has_switched(e, e.cells[c])) {
+          switched_at[k][c] = i;
         }
       }
+      EventResponse& r = result.events[k];
       while (s.stamp >= next_sample[k]) {
         r.times.push_back(next_sample[k]);
         r.mean_occupancy.push_back(mean_occupancy(e));
         next_sample[k] += options.sample_period;
       }
     }
+  }
+  // An event's response: the `fraction` quantile of its cells' delays from first view to switch.
+  for (std::size_t k = 0; k < events.size(); ++k) {
+    const WorldEvent& e = events[k];
+    std::vector<std::pair<std::size_t, double>> delays;  // (scans, seconds); kNever: never
+    for (std::size_t c = 0; c < e.cells.size(); ++c) {
+      const std::size_t at = switched_at[k][c];
+      delays.emplace_back(at == kNever ? kNever : at - e.first_view[c] + 1,
+                          at == kNever ? std::numeric_limits<double>::infinity()
+                                       : scans[at].stamp - scans[e.first_view[c]].stamp);
+    }
+    if (delays.empty()) continue;
+    std::sort(delays.begin(), delays.end());
+    const auto rank = static_cast<std::size_t>(
+        std::ceil(options.fraction * static_cast<double>(delays.size())));
+    const std::size_t q = std::min(delays.size(), std::max<std::size_t>(rank, 1)) - 1;
+    result.events[k].scans = delays[q].first;
+    result.events[k].seconds = delays[q].second;
   }
   result.total_s = total;
   result.mean_scan_us = scans.empty() ? 0.0 : 1e6 * total / static_cast<double>(scans.size());

@@ -40,7 +40,11 @@ struct WorldEvent {
   std::string name;          ///< the object's name
   double start_time = 0.0;   ///< departure: when it starts moving; arrival: when it appears (s)
   double event_time = 0.0;   ///< departure: when its parking footprint is clear; arrival: parked
-  std::vector<CellIndex> cells;  ///< the cells that saw it: >= 2 true beam hits while it was parked
+  /// The cells that saw it (>= 2 true beam hits while it was parked) and that the lasers observe
+  /// again after the event: free (departure) or hit (arrival).
+  std::vector<CellIndex> cells;
+  /// Per cell, the index (in the scans) of the first scan after the event that observes it.
+  std::vector<std::size_t> first_view;
 };
 
 /// The departures and arrivals of a world (objects with role departing / arriving), with the
@@ -50,9 +54,10 @@ std::vector<WorldEvent> findEvents(const World& world, const std::vector<SimScan
 
 /// What a policy did with one event.
 struct EventResponse {
-  /// Time (s) and scans (all lasers) from event_time until at least `fraction` of the event's
-  /// cells are free (departure: P(occ) < 0.5) or occupied (arrival: P(occ) > 0.5); +inf and
-  /// SIZE_MAX if never within the scenario.
+  /// Delay of the event's cells from their first view after the event to their switch (departure:
+  /// P(occ) < 0.5, arrival: P(occ) > 0.5), in seconds and in scans of all lasers (the viewing scan
+  /// counts as 1): the `fraction` quantile over the cells. +inf and SIZE_MAX if that many cells
+  /// never switch within the scenario.
   double seconds = std::numeric_limits<double>::infinity();
   std::size_t scans = std::numeric_limits<std::size_t>::max();
   /// Mean P(occ) over the event's cells, sampled every `sample_period` seconds.
@@ -82,7 +87,7 @@ struct PolicyResult {
 
 /// Options of an evaluation.
 struct EvaluationOptions {
-  double fraction = 0.9;        ///< share of an event's cells that must have switched
+  double fraction = 0.9;        ///< quantile of the cells' delays reported per event
   double sample_period = 0.1;   ///< period of the occupancy curves (s)
   double wall_margin = 1.0;     ///< occupied cells count for wall_distance within this of a wall
 };
