@@ -560,16 +560,22 @@ WorkloadResult runWorkload(const Workload& wl, const Options& opt) {
     r.own_bytes = full[k]->ownBytes();
     r.observed = full[k]->observedCells();
     r.work_per_scan = static_cast<double>(full[k]->work()) / static_cast<double>(wl.scans.size());
-    // Timed repetitions, each into a fresh structure; construction and destruction not timed.
-    for (int rep = 0; rep < opt.reps; ++rep) {
+  }
+  // Timed repetitions, each into a fresh structure (construction and destruction not timed).
+  // The structures take turns within each repetition, so a burst of load from other processes
+  // on a shared machine lands on all of them rather than on one.
+  for (int rep = 0; rep < opt.reps; ++rep) {
+    for (int k = 0; k < kSubjects; ++k) {
       std::unique_ptr<Subject> m = make[k]();
       const auto a = Clock::now();
       for (std::size_t i = 0; i < wl.timed_scans; ++i) m->integrate(wl.scans[i]);
       const auto b = Clock::now();
-      r.rep_seconds.push_back(seconds(a, b));
+      res.subject[k].rep_seconds.push_back(seconds(a, b));
     }
-    const double med = median(r.rep_seconds);
-    r.scans_per_s = static_cast<double>(wl.timed_scans) / med;
+  }
+  for (int k = 0; k < kSubjects; ++k) {
+    SubjectResult& r = res.subject[k];
+    r.scans_per_s = static_cast<double>(wl.timed_scans) / median(r.rep_seconds);
     r.min_s = *std::min_element(r.rep_seconds.begin(), r.rep_seconds.end());
     r.max_s = *std::max_element(r.rep_seconds.begin(), r.rep_seconds.end());
     std::cerr << "  " << std::setw(12) << kSubjectNames[k] << ": " << std::fixed
