@@ -65,6 +65,13 @@ if(CATKIN_ENABLE_TESTING)
         WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
     endif()
 
+    # The test room as a standalone publisher (make rviz-check).
+    add_executable(room_scene test/ros/room_scene.cpp)
+    target_include_directories(room_scene SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(room_scene ${catkin_LIBRARIES})
+    set_target_properties(room_scene PROPERTIES
+      RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+
     # Every launch file parses and names existing nodes.
     roslaunch_add_file_check(launch IGNORE_UNSET_ARGS DEPENDENCIES ${WAVOG_ROS_RUNTIME})
   endif()

@@ -1,0 +1,32 @@
+# ROS layer targets (issue 3). Neither is part of `make test`.
+#   make tsan         ThreadSanitizer build of the node in $(BUILD_TSAN) and the integration rostest
+#                     run against it (4 scan inputs + publication timer + services on 4 threads).
+#   make rviz-check   installs rviz + Xvfb (separate from `make deps`), runs rviz/wavog.rviz under
+#                     Xvfb against the integration scene and writes $(RVIZ_SHOT).
+BUILD_TSAN ?= $(ROOT)/build-tsan
+RVIZ_SHOT ?= $(ROOT)/build/rviz_screenshot.png
+ROS_ENV := export ROS_DISTRO=Debian ROS_MASTER_URI=$${ROS_MASTER_URI:-http://localhost:11311}
+
+.PHONY: tsan rviz-check
+
+tsan: deps
+	@mkdir -p $(BUILD_TSAN)/tsan
+	@cmake -S $(ROOT) -B $(BUILD_TSAN) -DCATKIN_DEVEL_PREFIX=$(BUILD_TSAN)/devel $(CMAKE_ARGS) \
+	  -DWAVOG_SANITIZE=thread -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  >$(BUILD_TSAN)/configure.log || { cat $(BUILD_TSAN)/configure.log; exit 1; }
+	@cmake --build $(BUILD_TSAN) -j$(JOBS) --target wavog_mapping_node test_mapping_system \
+	  -- --no-print-directory
+	@rm -f $(BUILD_TSAN)/tsan/report.*
+	@$(ROS_ENV); source $(BUILD_TSAN)/devel/setup.bash; \
+	  export ROS_HOME=$(BUILD_TSAN)/ros_home; \
+	  export TSAN_OPTIONS="log_path=$(BUILD_TSAN)/tsan/report second_deadlock_stack=1 history_size=4"; \
+	  rostest wavog_mapping mapping_node.test
+	@if ls $(BUILD_TSAN)/tsan/report.* >/dev/null 2>&1; then \
+	  cat $(BUILD_TSAN)/tsan/report.*; echo "tsan: ThreadSanitizer reports above"; exit 1; \
+	else echo "tsan: no data race reported"; fi
+
+rviz-check: build
+	@command -v rviz >/dev/null && command -v Xvfb >/dev/null || \
+	  { apt-get install -y -qq --no-install-recommends rviz xvfb x11-apps imagemagick >/dev/null; }
+	@$(ROS_ENV); source $(BUILD)/devel/setup.bash; export ROS_HOME=$(BUILD)/ros_home; \
+	  bash $(ROOT)/test/ros/rviz_screenshot.sh $(RVIZ_SHOT)
