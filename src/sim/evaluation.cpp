@@ -11,6 +11,9 @@ namespace {
 
 constexpr double kFootprintStep = 0.01;  // time step when looking for a vacated footprint (s)
 constexpr int kMinHits = 2;              // true hits that make a cell part of an event
+// Log-odds margin around 0 (P = 0.5) for "occupied" and "free": a cell the map holds at exactly
+// the unknown value (e.g. max policy, seen free) may read back as +-1e-7 after the Haar round trip.
+constexpr float kDecisionMargin = 1e-3f;
 
 // True if the centre of `cell` lies on a beam of `scan` at least one cell before its true hit:
 // the lasers saw it free.
@@ -169,7 +172,7 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
 
   auto has_switched = [&map](const WorldEvent& e, const CellIndex& c) {
     const float v = map.value(c);
-    return e.type == WorldEvent::Type::kDeparture ? v < 0.0f : v > 0.0f;
+    return e.type == WorldEvent::Type::kDeparture ? v < -kDecisionMargin : v > kDecisionMargin;
   };
   auto mean_occupancy = [&map](const WorldEvent& e) {
     double sum = 0.0;
@@ -249,7 +252,7 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
   const std::vector<std::uint8_t> near_surface = dilate(surface, window);
   std::vector<std::uint8_t> occupied(window.size(), 0);
   for (std::size_t i = 0; i < window.size(); ++i) {
-    occupied[i] = result.final_map.known[i] && result.final_map.log_odds[i] > 0.0f;
+    occupied[i] = result.final_map.known[i] && result.final_map.log_odds[i] > kDecisionMargin;
   }
   const std::vector<std::uint8_t> near_occupied = dilate(occupied, window);
   std::size_t occ = 0, occ_ok = 0, seen_surface = 0, seen_surface_ok = 0;
