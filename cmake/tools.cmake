@@ -58,7 +58,40 @@ if(TARGET wavog_offline AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_o
   add_dependencies(test_offline wavog_log2bag wavog_offline)
 endif()
 
-if(CATKIN_ENABLE_TESTING AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/playback.test)
-  find_package(rostest REQUIRED)
-  add_rostest(test/tools/playback.test DEPENDENCIES wavog_log2bag wavog_offline)
+# Playback rostest: the first 300 scans of fr079 converted (fixture tools_playback_bag), played
+# through launch/playback.launch into the node, compared with wavog_offline's map.
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
+   AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/playback.test)
+  if(DEFINED ENV{WAVOG_DATA_DIR})
+    set(_wavog_data_dir $ENV{WAVOG_DATA_DIR})
+  else()
+    get_filename_component(_wavog_data_dir ${CMAKE_CURRENT_SOURCE_DIR}/../shared/data ABSOLUTE)
+  endif()
+  if(EXISTS ${_wavog_data_dir}/fr079-corrected.log.gz)
+    find_package(rostest REQUIRED)
+    add_executable(test_playback test/tools/test_playback.cpp)
+    target_include_directories(test_playback SYSTEM PRIVATE ${catkin_INCLUDE_DIRS}
+                               ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
+    target_link_libraries(test_playback PRIVATE wavog_ros_config wavog_core ${catkin_LIBRARIES}
+                          GTest::GTest)
+    target_compile_options(test_playback PRIVATE ${WAVOG_WARNINGS})
+    target_compile_definitions(test_playback PRIVATE WAVOG_OFFLINE="$<TARGET_FILE:wavog_offline>")
+    set_target_properties(test_playback PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
+    add_dependencies(test_playback ${PROJECT_NAME}_generate_messages_cpp wavog_offline)
+
+    set(_wavog_playback_bag ${CMAKE_BINARY_DIR}/test_data/playback_fr079_300.bag)
+    add_test(NAME tools_playback_bag
+             COMMAND sh -c "mkdir -p ${CMAKE_BINARY_DIR}/test_data && $<TARGET_FILE:wavog_log2bag> --quiet --max-scans 300 --pad 60 ${_wavog_data_dir}/fr079-corrected.log.gz ${_wavog_playback_bag}")
+    set_tests_properties(tools_playback_bag PROPERTIES FIXTURES_SETUP wavog_playback_bag
+                         LABELS "tools" TIMEOUT 60)
+    # The bag's path reaches the launch file through the environment (rostest ARGS would end up
+    # in the test's name).
+    add_rostest(test/tools/playback.test DEPENDENCIES test_playback wavog_mapping_node wavog_offline)
+    set_tests_properties(_ctest_${PROJECT_NAME}_rostest_test_tools_playback.test PROPERTIES
+                         FIXTURES_REQUIRED wavog_playback_bag LABELS "tools;rostest" TIMEOUT 300
+                         ENVIRONMENT "WAVOG_PLAYBACK_BAG=${_wavog_playback_bag}")
+  else()
+    message(STATUS "wavog tools: ${_wavog_data_dir}/fr079-corrected.log.gz not found; "
+                   "playback rostest not registered (set WAVOG_DATA_DIR)")
+  endif()
 endif()

@@ -26,6 +26,7 @@ namespace {
 
 constexpr double kDefaultEpoch = 1.6e9;  // 2020-09-13: where relative log times start
 constexpr double kDefaultRate = 10.0;    // Hz, for synthesised stamps
+constexpr double kHoldStep = 0.5;        // s after the last scan: first /tf of the held pose
 
 struct Options {
   std::string log;
@@ -38,6 +39,7 @@ struct Options {
   double epoch = kDefaultEpoch;
   double range_min = 0.0;
   std::string compression = "none";
+  double pad = 0.0;
   bool quiet = false;
 };
 
@@ -55,12 +57,16 @@ void usage(std::FILE* out) {
                "  --epoch S           relative stamps are shifted to start here (default 1.6e9)\n"
                "  --range-min M       range_min of the scans (default 0)\n"
                "  --compression none|bz2|lz4  bag chunk compression (default none)\n"
+               "  --pad S             S seconds of bag time before the first scan (only /tf_static)\n"
+               "                      and after the last (the last pose held on /tf), so that\n"
+               "                      `rosbag play` subscribers connect in time, the last scan's tf\n"
+               "                      is complete, and nodes can be queried before play exits\n"
                "  --quiet             only errors\n"
                "  -h, --help\n");
 }
 
 bool parseOptions(int argc, char** argv, Options* o) {
-  enum { kMax = 1000, kStrict, kOdom, kStamp, kRate, kEpoch, kRangeMin, kCompression, kQuiet };
+  enum { kMax = 1000, kStrict, kOdom, kStamp, kRate, kEpoch, kRangeMin, kCompression, kPad, kQuiet };
   const option longopts[] = {{"max-scans", required_argument, nullptr, kMax},
                              {"strict", no_argument, nullptr, kStrict},
                              {"odom", no_argument, nullptr, kOdom},
@@ -69,6 +75,7 @@ bool parseOptions(int argc, char** argv, Options* o) {
                              {"epoch", required_argument, nullptr, kEpoch},
                              {"range-min", required_argument, nullptr, kRangeMin},
                              {"compression", required_argument, nullptr, kCompression},
+                             {"pad", required_argument, nullptr, kPad},
                              {"quiet", no_argument, nullptr, kQuiet},
                              {"help", no_argument, nullptr, 'h'},
                              {nullptr, 0, nullptr, 0}};
@@ -88,6 +95,7 @@ bool parseOptions(int argc, char** argv, Options* o) {
       case kEpoch: o->epoch = std::stod(optarg); break;
       case kRangeMin: o->range_min = std::stod(optarg); break;
       case kCompression: o->compression = optarg; break;
+      case kPad: o->pad = std::stod(optarg); break;
       case kQuiet: o->quiet = true; break;
       case 'h': usage(stdout); std::exit(0);
       default: return false;
@@ -97,6 +105,7 @@ bool parseOptions(int argc, char** argv, Options* o) {
   o->log = argv[optind];
   o->bag = argv[optind + 1];
   if (!(o->rate > 0.0) || !std::isfinite(o->rate)) throw std::invalid_argument("--rate must be > 0");
+  if (!(o->pad >= 0.0) || o->pad > 3600.0) throw std::invalid_argument("--pad must be in [0, 3600]");
   if (!(o->range_min >= 0.0)) throw std::invalid_argument("--range-min must be >= 0");
   if (o->compression != "none" && o->compression != "bz2" && o->compression != "lz4") {
     throw std::invalid_argument("--compression must be none, bz2 or lz4");
@@ -159,6 +168,23 @@ int run(const Options& o) {
   std::size_t tf_messages = 0;
   std::size_t reported_errors = 0;
   bool static_written = false;
+  ros::Time last_stamp;
+  wavog::Pose2 last_base;
+  // One latched message with every laser mount, so that `rosbag play` re-latches it.
+  auto write_static = [&](const ros::Time& stamp) {
+    tf2_msgs::TFMessage statics;
+    for (const auto& l : plan.lasers) {
+      if (l.used) statics.transforms.push_back(toTransform(base_frame, l.frame, l.mount, stamp));
+    }
+    auto header = boost::make_shared<ros::M_string>();
+    // A custom connection header replaces rosbag's own: it must carry the type fields too.
+    (*header)["type"] = ros::message_traits::datatype<tf2_msgs::TFMessage>();
+    (*header)["md5sum"] = ros::message_traits::md5sum<tf2_msgs::TFMessage>();
+    (*header)["message_definition"] = ros::message_traits::definition<tf2_msgs::TFMessage>();
+    (*header)["callerid"] = "/wavog_log2bag";
+    (*header)["latching"] = "1";
+    bag.write("/tf_static", stamp, statics, header);
+  };
   std::string fatal;
   wavog::CarmenScan scan;
   try {
@@ -175,26 +201,16 @@ int run(const Options& o) {
       wavog_tools::toSecNsec(stamps.repair(raw), &sec, &nsec);
       const ros::Time stamp(sec, nsec);
       if (!static_written) {
-        // One latched message with every laser mount, so that `rosbag play` re-latches it.
-        tf2_msgs::TFMessage statics;
-        for (const auto& l : plan.lasers) {
-          if (l.used) statics.transforms.push_back(toTransform(base_frame, l.frame, l.mount, stamp));
-        }
-        auto header = boost::make_shared<ros::M_string>();
-        // A custom connection header replaces rosbag's own: it must carry the type fields too.
-        (*header)["type"] = ros::message_traits::datatype<tf2_msgs::TFMessage>();
-        (*header)["md5sum"] = ros::message_traits::md5sum<tf2_msgs::TFMessage>();
-        (*header)["message_definition"] = ros::message_traits::definition<tf2_msgs::TFMessage>();
-        (*header)["callerid"] = "/wavog_log2bag";
-        (*header)["latching"] = "1";
-        bag.write("/tf_static", stamp, statics, header);
+        write_static(stamp - ros::Duration(o.pad));
         static_written = true;
       }
+      last_stamp = stamp;
       // base_link pose such that base_link * mount is exactly the logged laser pose (corrected),
       // or the robot's odometry pose with --odom.
       const wavog::Pose2 base = o.odom ? scan.robot_pose
                                        : wavog_tools::compose(scan.laser_pose,
                                                               wavog_tools::inverse(laser->mount));
+      last_base = base;
       tf2_msgs::TFMessage tf;
       tf.transforms.push_back(toTransform(fixed_frame, base_frame, base, stamp));
       bag.write("/tf", stamp, tf);
@@ -212,6 +228,18 @@ int run(const Options& o) {
     std::cerr << "wavog_log2bag: skipped malformed line: " << reader.errors()[reported_errors]
               << "\n";
   }
+  if (static_written && o.pad > 0.0) {
+    // The robot holds its last pose through the padding: a node that waits for tf after a scan's
+    // stamp (motion compensation) can place the last scan too.
+    const ros::Time end = last_stamp + ros::Duration(o.pad);
+    for (const ros::Time& t : {last_stamp + ros::Duration(std::min(o.pad, kHoldStep)), end}) {
+      tf2_msgs::TFMessage tf;
+      tf.transforms.push_back(toTransform(fixed_frame, base_frame, last_base, t));
+      bag.write("/tf", t, tf);
+      ++tf_messages;
+    }
+    write_static(end);
+  }
   bag.close();
   if (!fatal.empty() && o.strict) {
     std::filesystem::remove(o.bag);
@@ -222,7 +250,7 @@ int run(const Options& o) {
     std::cerr << "wavog_log2bag: wrote " << o.bag << ": " << written << " scans";
     for (const auto& [topic, n] : per_topic) std::cerr << ", " << n << " on " << topic;
     std::cerr << ", " << tf_messages << " on /tf (" << fixed_frame << " -> " << base_frame
-              << "), 1 on /tf_static\n";
+              << "), " << (o.pad > 0.0 ? 2 : 1) << " on /tf_static\n";
     for (const auto& l : plan.lasers) {
       if (l.used && !l.mount_from_log) {
         std::cerr << "wavog_log2bag: " << l.type << ": the log's robot pose is not in the laser "

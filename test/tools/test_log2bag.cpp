@@ -241,6 +241,23 @@ TEST(Log2Bag, RepairsStampsAndReportsEachKindOnce) {
       << r.err;
 }
 
+TEST(Log2Bag, PadHoldsTheLastPoseAndRepeatsTheStaticTransforms) {
+  const std::string log = writeLog("pad.log", {flaser(5.0), flaser(5.1)});
+  const std::string bag = (workDir() / "pad.bag").string();
+  const RunResult r = runLog2Bag("--pad 30 " + log + " " + bag);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const BagContent c = readBag(bag);
+  ASSERT_EQ(c.scans.size(), 2u);
+  ASSERT_EQ(c.tf_static.size(), 2u);
+  EXPECT_EQ(c.tf_static[0].header.stamp, c.scans[0].header.stamp - ros::Duration(30.0));
+  EXPECT_EQ(c.tf_static[1].header.stamp, c.scans[1].header.stamp + ros::Duration(30.0));
+  ASSERT_EQ(c.tf.size(), 4u);  // one per scan, then the last pose held at +0.5 s and +30 s
+  EXPECT_EQ(c.tf[2].header.stamp, c.scans[1].header.stamp + ros::Duration(0.5));
+  EXPECT_EQ(c.tf[3].header.stamp, c.scans[1].header.stamp + ros::Duration(30.0));
+  EXPECT_EQ(c.tf[3].transform.translation.x, c.tf[1].transform.translation.x);
+  EXPECT_EQ(c.tf[3].transform.rotation.z, c.tf[1].transform.rotation.z);
+}
+
 TEST(Log2Bag, MissingInputAndBadUsage) {
   const std::string missing = (workDir() / "nope.log").string();
   RunResult r = runLog2Bag(missing + " " + (workDir() / "x.bag").string());
