@@ -31,6 +31,24 @@ constexpr double kUnchangedFloor = 1e-9;
 
 enum BeamKind : std::uint8_t { kInvalid = 0, kHit = 1, kClear = 2 };
 
+// atan2 from an odd polynomial on [0, 1] (coefficients fitted for this project by reweighted
+// least squares against std::atan; measured max error 2.5e-7 rad) and octant symmetry. Node
+// classification only needs bearings up to a known error, which it pads by kFastAtanError.
+constexpr double kFastAtanError = 1e-6;
+inline double fastAtan2(double y, double x) {
+  constexpr double kC[7] = {0.99999611591913118,  -0.33317382497041043, 0.19807947831023187,
+                            -0.1323385017280396,  0.079633010601756773, -0.033612359910421385,
+                            0.0068144960901458541};
+  const double ax = std::fabs(x), ay = std::fabs(y);
+  const double mx = std::max(ax, ay), mn = std::min(ax, ay);
+  if (mx == 0.0) return 0.0;
+  const double a = mn / mx, q = a * a;
+  double r = a * (kC[0] + q * (kC[1] + q * (kC[2] + q * (kC[3] + q * (kC[4] + q * (kC[5] + q * kC[6]))))));
+  if (ay > ax) r = 1.57079632679489661923 - r;
+  if (x < 0) r = 3.14159265358979323846 - r;
+  return y < 0 ? -r : r;
+}
+
 /// Everything about one scan that node and cell classification need. Reused between scans.
 struct PreparedScan {
   double px = 0, py = 0, theta = 0;  // sensor pose
@@ -100,10 +118,10 @@ struct PreparedScan {
     const double r_max = std::sqrt(fx * fx + fy * fy);
 
     // Bearing interval of the square (convex, not containing the sensor: span < pi).
-    double b[4] = {normalise(std::atan2(y0 - py, x0 - px) - theta),
-                   normalise(std::atan2(y0 - py, x1 - px) - theta),
-                   normalise(std::atan2(y1 - py, x0 - px) - theta),
-                   normalise(std::atan2(y1 - py, x1 - px) - theta)};
+    double b[4] = {normalise(fastAtan2(y0 - py, x0 - px) - theta),
+                   normalise(fastAtan2(y0 - py, x1 - px) - theta),
+                   normalise(fastAtan2(y1 - py, x0 - px) - theta),
+                   normalise(fastAtan2(y1 - py, x1 - px) - theta)};
     double lo = std::min({b[0], b[1], b[2], b[3]}), hi = std::max({b[0], b[1], b[2], b[3]});
     bool straddles = false;
     if (hi - lo > kPi) {  // crosses the seam behind the field of view: unwrap
@@ -116,8 +134,8 @@ struct PreparedScan {
     }
     // Beams j whose sector may hold a point of [lo, hi]: the cells' lround() lands in [jlo, jhi].
     auto beamRange = [&](double a_lo, double a_hi, long* jlo, long* jhi) {
-      const double t_lo = (a_lo - amin) / inc - 0.5 - kIndexSlack;
-      const double t_hi = (a_hi - amin) / inc + 0.5 + kIndexSlack;
+      const double t_lo = (a_lo - kFastAtanError - amin) / inc - 0.5 - kIndexSlack;
+      const double t_hi = (a_hi + kFastAtanError - amin) / inc + 0.5 + kIndexSlack;
       *jlo = static_cast<long>(std::ceil(std::max(t_lo, -1.0)));
       *jhi = static_cast<long>(std::floor(std::min(t_hi, static_cast<double>(n))));
     };

@@ -1,0 +1,196 @@
+// Core benchmarks (make bench): scans/s, nodes visited per scan and bytes per observed cell for
+// clamping, lazy forgetting and eager forgetting on fr079 and on synthetic 80 m LMS-291 scans,
+// then the ratios of the issue's targets, computed from medians measured in this same run.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "wavog_mapping/core/wavelet_map.h"
+#include "wavog_mapping/io/carmen_reader.h"
+
+namespace {
+
+using wavog::MapParams;
+using wavog::PolicyType;
+
+struct Scan {
+  wavog::Pose2 pose;
+  std::vector<float> ranges;
+  double angle_min, angle_increment, range_min, range_max;
+  wavog::ScanView view() const {
+    return {ranges.data(), ranges.size(), angle_min, angle_increment, range_min, range_max};
+  }
+};
+
+std::vector<Scan> loadFr079() {
+  const std::string dir = wavog::findDataDir(WAVOG_SOURCE_DIR);
+  std::vector<Scan> out;
+  if (dir.empty()) return out;
+  for (const auto& c : wavog::readCarmenLog(dir + "/fr079-corrected.log.gz")) {
+    const auto v = c.view();
+    out.push_back({c.laser_pose, c.ranges, v.angle_min, v.angle_increment, v.range_min, v.range_max});
+  }
+  return out;
+}
+
+// A vehicle driving a gentle S curve at 5 m/s; one LMS-291 at 40 Hz (361 beams over 180 deg)
+// seeing surfaces 60-80 m away that vary with bearing and time.
+std::vector<Scan> synthetic80m(int count) {
+  const double kPi = 3.14159265358979323846;
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Scan> out;
+  for (int i = 0; i < count; ++i) {
+    Scan s;
+    const double t = i * 0.025;  // 40 Hz
+    s.pose = {5.0 * t, 3.0 * std::sin(0.2 * t), 0.3 * std::cos(0.2 * t)};
+    s.angle_min = -kPi / 2;
+    s.angle_increment = kPi / 360;
+    s.range_min = 0.5;
+    s.range_max = 81.0;
+    for (int j = 0; j < 361; ++j) {
+      const double b = s.angle_min + j * s.angle_increment;
+      double r = 70.0 + 8.0 * std::sin(3 * b + 0.05 * t) + 2.0 * std::sin(17 * b) + (u(rng) - 0.5) * 0.1;
+      s.ranges.push_back(static_cast<float>(r));
+    }
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+const std::vector<Scan>& workload(const std::string& name) {
+  static std::map<std::string, std::vector<Scan>> cache;
+  auto it = cache.find(name);
+  if (it != cache.end()) return it->second;
+  return cache[name] = name == "fr079" ? loadFr079() : synthetic80m(1000);
+}
+
+enum Variant { kClamp = 0, kForgetLazy = 1, kForgetEager = 2 };
+const char* kVariantNames[] = {"clamp", "forget_lazy", "forget_eager"};
+
+MapParams paramsFor(Variant v, double res, double tau) {
+  MapParams p = MapParams::defaultsFor(v == kClamp ? PolicyType::kClamp : PolicyType::kForget);
+  p.grid.resolution = res;
+  p.lazy_forgetting = v != kForgetEager;
+  p.prune_threshold = tau;
+  return p;
+}
+
+struct Figures {
+  double scans_per_s = 0, visited_per_scan = 0, bytes_per_cell = 0;
+};
+std::map<std::string, std::vector<double>> g_rates;  // key -> scans/s per repetition
+std::map<std::string, Figures> g_figures;
+
+void BM_Integrate(benchmark::State& state, std::string wl, double res, Variant v) {
+  const auto& scans = workload(wl);
+  if (scans.empty()) {
+    state.SkipWithError("data set not found (../shared/data or WAVOG_DATA_DIR)");
+    return;
+  }
+  const std::string key = wl + "@" + std::to_string(static_cast<int>(std::lround(res * 100))) + "cm/" + kVariantNames[v];
+  Figures f;
+  for (auto _ : state) {
+    wavog::WaveletMap map(paramsFor(v, res, 0.0));
+    std::uint64_t visited = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const auto& s : scans) visited += map.integrate(s.pose, s.view()).nodes_visited;
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(secs);
+    state.PauseTiming();
+    const auto st = map.stats(true);
+    f.scans_per_s = static_cast<double>(scans.size()) / secs;
+    f.visited_per_scan = static_cast<double>(visited) / static_cast<double>(scans.size());
+    f.bytes_per_cell = static_cast<double>(st.bytes) / static_cast<double>(std::max<std::uint64_t>(1, st.observed_cells));
+    g_rates[key].push_back(f.scans_per_s);
+    state.ResumeTiming();
+  }
+  g_figures[key] = f;
+  state.counters["scans_per_s"] = f.scans_per_s;
+  state.counters["visited_per_scan"] = f.visited_per_scan;
+  state.counters["bytes_per_cell"] = f.bytes_per_cell;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+void printSummary() {
+  std::printf("\n== Summary (median scans/s over repetitions, same run) ==\n");
+  std::printf("%-32s %12s %14s %14s\n", "workload/variant", "scans/s", "visited/scan", "bytes/cell");
+  for (const auto& kv : g_figures) {
+    std::printf("%-32s %12.0f %14.0f %14.3f\n", kv.first.c_str(), median(g_rates[kv.first]),
+                kv.second.visited_per_scan, kv.second.bytes_per_cell);
+  }
+  auto m = [](const std::string& k) { return median(g_rates[k]); };
+  std::printf("\n== Targets ==\n");
+  for (const char* wl : {"fr079", "synthetic80m"}) {
+    for (const char* res : {"5cm", "10cm"}) {
+      const std::string base = std::string(wl) + "@" + res + "/";
+      if (!g_rates.count(base + "clamp")) continue;
+      std::printf("%-20s forget_lazy cost / clamp cost = %.2f (target <= 1.1)\n", (std::string(wl) + "@" + res).c_str(),
+                  m(base + "clamp") / m(base + "forget_lazy"));
+      std::printf("%-20s lazy / eager speed           = %.2f (target >= 3 on 80 m)\n", (std::string(wl) + "@" + res).c_str(),
+                  m(base + "forget_lazy") / m(base + "forget_eager"));
+    }
+  }
+  if (g_rates.count("synthetic80m@5cm/forget_lazy")) {
+    std::printf("synthetic80m@5cm forget_lazy: %.0f scans/s (target >= 1000)\n", m("synthetic80m@5cm/forget_lazy"));
+  }
+  // Memory and pruning error on fr079 at 5 cm with forgetting, tau = 0, 0.01, 0.05.
+  if (!g_rates.count("fr079@5cm/forget_lazy")) return;  // only with the fr079 5 cm runs
+  const auto& scans = workload("fr079");
+  std::printf("\n== fr079 @ 5 cm, forgetting: memory and pruning error ==\n");
+  wavog::WaveletMap exact(paramsFor(kForgetLazy, 0.05, 0.0));
+  for (const auto& s : scans) exact.integrate(s.pose, s.view());
+  wavog::CellBox box;
+  exact.bounds(0, &box);
+  const auto ref = exact.exportScale(0, box, wavog::Aggregation::kMean);
+  for (double tau : {0.0, 0.01, 0.05}) {
+    wavog::WaveletMap map(paramsFor(kForgetLazy, 0.05, tau));
+    for (const auto& s : scans) map.integrate(s.pose, s.view());
+    const auto st = map.stats(true);
+    const auto r = map.exportScale(0, box, wavog::Aggregation::kMean);
+    double max_err = 0;
+    for (std::size_t i = 0; i < r.log_odds.size(); ++i) {
+      max_err = std::max(max_err, static_cast<double>(std::fabs(r.log_odds[i] - ref.log_odds[i])));
+    }
+    std::printf("tau %.2f: %zu nodes, %zu bytes, %llu observed cells, %.3f bytes/cell (target <= 1 "
+                "at tau 0), max |error| vs tau 0: %.4f log-odds\n",
+                tau, st.nodes, st.bytes, static_cast<unsigned long long>(st.observed_cells),
+                static_cast<double>(st.bytes) / static_cast<double>(st.observed_cells), max_err);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (const char* wl : {"fr079", "synthetic80m"}) {
+    for (double res : {0.05, 0.10}) {
+      for (Variant v : {kClamp, kForgetLazy, kForgetEager}) {
+        const std::string name = std::string("integrate/") + wl + "/" +
+                                 std::to_string(static_cast<int>(std::lround(res * 100))) + "cm/" + kVariantNames[v];
+        benchmark::RegisterBenchmark(name.c_str(), BM_Integrate, std::string(wl), res, v)
+            ->UseManualTime()
+            ->Unit(benchmark::kMillisecond)
+            ->Iterations(1)
+            ->Repetitions(5)
+            ->ReportAggregatesOnly(true);
+      }
+    }
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  printSummary();
+  return 0;
+}
