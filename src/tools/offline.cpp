@@ -1,6 +1,7 @@
 // wavog_offline: maps a rosbag or a CARMEN log without a roscore, as fast as the core allows.
 // Bags: /tf and /tf_static go into a tf2::BufferCore first, then every scan of the chosen topics is
-// placed with lookupTransform(fixed frame, scan frame, stamp) and integrated. CARMEN logs: the
+// placed with lookupTransform(fixed frame, scan frame, stamp) and integrated through the node's
+// conversions (scan checks, mirrored lasers, motion compensation over the sweep). CARMEN logs: the
 // logged (corrected) laser poses are used as they are. The parameters come from the node's YAML
 // through the one loader (wavog_ros::configFromXmlRpc). Writes per scale a PNG, a map_server PGM +
 // YAML, the native map, summary.json and optional snapshots.
@@ -32,17 +33,18 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "tool_support.h"
+#include "wavog_mapping/core/motion_compensation.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/ros/config.h"
+#include "wavog_mapping/ros/conversions.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-constexpr double kLevelTolerance = 0.99;  // |z axis . up| below: the laser is not level (dropped)
 constexpr int kCropMargin = 2;            // unknown cells kept around the known part of a picture
 constexpr double kTfCacheMargin = 60.0;   // s added to the bag's duration for the tf buffer
 
@@ -281,6 +283,8 @@ struct InputInfo {
   std::string fixed_frame;
   std::string read_error;
   std::vector<std::string> warnings;
+  std::size_t motion_compensated = 0;  // scans re-binned over their sweep (bags with time_increment)
+  std::size_t motion_fallbacks = 0;    // no tf at the sweep's end: integrated uncompensated
 };
 
 std::string describeBagTopics(const rosbag::Bag& bag) {
@@ -301,20 +305,6 @@ std::string describeBagTopics(const rosbag::Bag& bag) {
 }
 
 std::string normaliseTopic(const std::string& t) { return t.empty() || t[0] == '/' ? t : "/" + t; }
-
-/// Planar pose of a transform and whether the sensor is upside down; false if it is not level.
-bool planarPose(const geometry_msgs::Transform& t, wavog::Pose2* pose, bool* flipped) {
-  const double qx = t.rotation.x, qy = t.rotation.y, qz = t.rotation.z, qw = t.rotation.w;
-  const double r00 = 1.0 - 2.0 * (qy * qy + qz * qz);
-  const double r10 = 2.0 * (qx * qy + qz * qw);
-  const double r22 = 1.0 - 2.0 * (qx * qx + qy * qy);
-  if (std::fabs(r22) < kLevelTolerance) return false;
-  pose->x = t.translation.x;
-  pose->y = t.translation.y;
-  pose->theta = std::atan2(r10, r00);
-  *flipped = r22 < 0.0;
-  return true;
-}
 
 InputInfo runBag(const Options& o, const wavog_ros::Config& config,
                  std::unique_ptr<Session>* session) {
@@ -388,6 +378,7 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   Session& s = **session;
   std::string first_tf_error;
   std::set<std::string> scan_frames;
+  wavog::MotionCompensator compensator;
   for (const rosbag::MessageInstance& m : scans) {
     if (s.done() >= total) break;
     const auto scan = m.instantiate<sensor_msgs::LaserScan>();
@@ -395,33 +386,56 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
       s.skip("not_a_laserscan");
       continue;
     }
-    const std::string frame = wavog_tools::stripSlash(scan->header.frame_id);
+    // Old bags carry frame ids with a leading '/', which tf2 rejects: strip it (the bag's tf
+    // frames were stripped the same way).
+    scan->header.frame_id = wavog_tools::stripSlash(scan->header.frame_id);
+    const std::string& frame = scan->header.frame_id;
     scan_frames.insert(frame);
-    wavog::Pose2 pose;
-    bool flipped = false;
+    wavog_ros::DropReason reason = wavog_ros::DropReason::kEmpty;
+    if (!wavog_ros::checkScan(*scan, &reason)) {
+      s.skip(std::string("scan_") + wavog_ros::toString(reason));
+      continue;
+    }
+    // The same steps as the node (MappingRos): pose at the stamp, mirrored view for an upside-down
+    // laser, motion compensation over the sweep when the scan times its beams.
+    wavog::Pose2 pose0;
+    bool mirrored = false;
+    bool compensate = false;
+    wavog::Pose2 pose1;
     if (frame != info.fixed_frame) {
-      geometry_msgs::TransformStamped t;
       try {
-        t = tf.lookupTransform(info.fixed_frame, frame, scan->header.stamp);
+        pose0 = wavog_ros::toPose2(
+            tf.lookupTransform(info.fixed_frame, frame, scan->header.stamp).transform, &mirrored);
       } catch (const tf2::TransformException& e) {
         if (first_tf_error.empty()) first_tf_error = e.what();
         const bool extrapolation = dynamic_cast<const tf2::ExtrapolationException*>(&e) != nullptr;
         s.skip(extrapolation ? "tf_extrapolation" : "tf_unavailable");
         continue;
       }
-      if (!planarPose(t.transform, &pose, &flipped)) {
-        s.skip("laser_not_level");
-        continue;
+      const std::size_t n = scan->ranges.size();
+      if (config.ros.motion_compensation && n > 1 && std::isfinite(scan->time_increment) &&
+          scan->time_increment != 0.0f) {
+        const double sweep = static_cast<double>(scan->time_increment) * static_cast<double>(n - 1);
+        try {
+          bool mirrored_end = false;
+          pose1 = wavog_ros::toPose2(
+              tf.lookupTransform(info.fixed_frame, frame, scan->header.stamp + ros::Duration(sweep))
+                  .transform,
+              &mirrored_end);
+          compensate = true;
+        } catch (const tf2::TransformException&) {
+          ++info.motion_fallbacks;
+        }
       }
     }
-    wavog::ScanView view;
-    view.ranges = scan->ranges.data();
-    view.count = scan->ranges.size();
-    // An upside-down laser sees the plane mirrored: bearing b becomes -b.
-    view.angle_min = flipped ? -scan->angle_min : scan->angle_min;
-    view.angle_increment = flipped ? -scan->angle_increment : scan->angle_increment;
-    view.range_min = scan->range_min;
-    view.range_max = scan->range_max;
+    wavog::ScanView view = wavog_ros::toScanView(*scan);
+    if (mirrored) wavog_ros::mirrorView(&view);
+    wavog::Pose2 pose = pose0;
+    if (compensate) {
+      pose = wavog::interpolate(pose0, pose1, 0.5);
+      view = compensator.compensate(view, pose0, pose1, pose);
+      ++info.motion_compensated;
+    }
     s.integrate(pose, view, scan->header.stamp.toSec());
   }
   s.finish();
@@ -610,6 +624,8 @@ int run(const Options& o) {
        << wavog_tools::jsonNumber(s.integrateSeconds() > 0
                                       ? static_cast<double>(s.integrated()) / s.integrateSeconds()
                                       : 0.0)
+       << ",\n  \"motion_compensated\": " << info.motion_compensated
+       << ",\n  \"motion_fallbacks\": " << info.motion_fallbacks
        << ",\n  \"nodes_visited_per_scan\": "
        << wavog_tools::jsonNumber(s.integrated() > 0 ? static_cast<double>(s.nodesVisited()) /
                                                            static_cast<double>(s.integrated())
