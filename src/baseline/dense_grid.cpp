@@ -292,6 +292,11 @@ void DenseGrid::growToCover(std::int64_t min_x, std::int64_t min_y, std::int64_t
   height_ = new_height;
 }
 
+void DenseGrid::reserve(const CellBox& box) {
+  if (box.empty()) return;
+  growToCover(box.min_x, box.min_y, box.max_x - 1, box.max_y - 1);
+}
+
 std::int16_t DenseGrid::rawValue(std::int64_t ix, std::int64_t iy) const {
   const std::int64_t x = ix - origin_x_;
   const std::int64_t y = iy - origin_y_;

@@ -273,6 +273,26 @@ TEST(DenseGrid, GrowsInEveryDirectionAndKeepsContents) {
   EXPECT_GE(grid.bytes(), static_cast<std::size_t>(box.width() * box.height() * 4));
 }
 
+TEST(DenseGrid, ReserveCoversTheBoxAndScansInsideDoNotGrow) {
+  DenseGrid grid(testParams());
+  grid.reserve(wavog::CellBox{-100, -50, 200, 80});
+  const wavog::CellBox before = grid.extent();
+  EXPECT_LE(before.min_x, -100);
+  EXPECT_LE(before.min_y, -50);
+  EXPECT_GE(before.max_x, 200);
+  EXPECT_GE(before.max_y, 80);
+  EXPECT_EQ(grid.countObserved(), 0u);
+  grid.integrate(Pose2{0.05, 0.05, 0.0}, oneBeam(5.0f).view());
+  const wavog::CellBox after = grid.extent();
+  EXPECT_EQ(after.min_x, before.min_x);
+  EXPECT_EQ(after.max_x, before.max_x);
+  EXPECT_EQ(after.min_y, before.min_y);
+  EXPECT_EQ(after.max_y, before.max_y);
+  EXPECT_NEAR(grid.value({50, 0}), 0.85f, kTol);
+  grid.reserve(wavog::CellBox{});  // empty: nothing happens
+  EXPECT_EQ(grid.extent().min_x, before.min_x);
+}
+
 TEST(DenseGrid, StampWrapAroundKeepsOncePerScan) {
   DenseGrid grid(testParams());
   const TestScan far_beam = oneBeam(0.5f);

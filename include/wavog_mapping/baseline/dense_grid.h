@@ -72,6 +72,10 @@ class DenseGrid {
   /// grows the grid to cover the scan.
   DenseIntegrateStats integrate(const Pose2& sensor_pose, const ScanView& scan);
 
+  /// Makes the grid cover the cells of `box` now (contents kept), so that scans inside it never
+  /// grow the grid: a pre-sized grid, as costmap_2d uses. An empty box does nothing.
+  void reserve(const CellBox& box);
+
   /// Log-odds of a cell (0 if never observed) and whether it was observed.
   float value(const CellIndex& cell) const;
   bool isObserved(const CellIndex& cell) const;
