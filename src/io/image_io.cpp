@@ -1,7 +1,7 @@
 // PNG / PGM / map_server YAML writers (and small readers for tests and tools). The PNG encoder
-// writes one IDAT of zlib-compressed rows, each with filter byte 0 (none); the reader accepts all
-// five filter types of the PNG spec, so it also reads files from other encoders that use 8-bit
-// grey or RGB without interlacing.
+// writes one IDAT of zlib-compressed rows, each with the filter type that suits it best; the reader
+// accepts all five filter types of the PNG spec, so it also reads files from other encoders that
+// use 8-bit grey or RGB without interlacing.
 #include "wavog_mapping/io/image_io.h"
 
 #include <zlib.h>
@@ -73,6 +73,19 @@ void putChunk(std::string* out, const char type[4], const std::string& data) {
   const auto crc = crc32(0L, reinterpret_cast<const Bytef*>(body.data()),
                          static_cast<uInt>(body.size()));
   putBe32(out, static_cast<std::uint32_t>(crc));
+}
+
+/// zlib stream of `raw` at the best compression; throws naming `path` on failure.
+std::string deflate(const std::string& path, const std::string& raw) {
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::string packed(size, '\0');
+  if (compress2(reinterpret_cast<Bytef*>(&packed[0]), &size,
+                reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()),
+                Z_BEST_COMPRESSION) != Z_OK) {
+    throw std::runtime_error(path + ": zlib compression failed");
+  }
+  packed.resize(size);
+  return packed;
 }
 
 /// Paeth predictor of the PNG spec (filter type 4).
@@ -160,20 +173,52 @@ void writePng(const std::string& path, const Image& image) {
   checkImage(path, image);
   const std::size_t stride = static_cast<std::size_t>(image.width) *
                              static_cast<std::size_t>(image.channels);
-  std::string raw;
-  raw.reserve((stride + 1) * static_cast<std::size_t>(image.height));
+  // Two encodings, the smaller one kept: no filter, and per row the filter type with the smallest
+  // sum of |signed residuals| (the PNG spec's heuristic), which wins on smooth pictures but can
+  // lose on graded maps with sharp edges.
+  const std::size_t bpp = static_cast<std::size_t>(image.channels);
+  std::string plain;
+  std::string filtered;
+  plain.reserve((stride + 1) * static_cast<std::size_t>(image.height));
+  filtered.reserve(plain.capacity());
+  std::array<std::vector<std::uint8_t>, 5> candidates;
+  for (auto& c : candidates) c.resize(stride);
   for (int y = 0; y < image.height; ++y) {
-    raw.push_back('\0');  // filter type: none
-    raw.append(reinterpret_cast<const char*>(image.at(0, y)), stride);
+    const std::uint8_t* row = image.at(0, y);
+    const std::uint8_t* up = y > 0 ? image.at(0, y - 1) : nullptr;
+    plain.push_back('\0');
+    plain.append(reinterpret_cast<const char*>(row), stride);
+    std::size_t best = 0;
+    long best_cost = -1;
+    for (std::size_t f = 0; f < candidates.size(); ++f) {
+      long cost = 0;
+      for (std::size_t i = 0; i < stride; ++i) {
+        const int a = i >= bpp ? row[i - bpp] : 0;
+        const int b = up ? up[i] : 0;
+        const int c = (up && i >= bpp) ? up[i - bpp] : 0;
+        int predicted = 0;
+        switch (f) {
+          case 1: predicted = a; break;
+          case 2: predicted = b; break;
+          case 3: predicted = (a + b) / 2; break;
+          case 4: predicted = paeth(a, b, c); break;
+          default: break;
+        }
+        const auto residual = static_cast<std::uint8_t>((row[i] - predicted) & 0xff);
+        candidates[f][i] = residual;
+        cost += residual < 128 ? residual : 256 - residual;
+      }
+      if (best_cost < 0 || cost < best_cost) {
+        best_cost = cost;
+        best = f;
+      }
+    }
+    filtered.push_back(static_cast<char>(best));
+    filtered.append(reinterpret_cast<const char*>(candidates[best].data()), stride);
   }
-  uLongf packed_size = compressBound(static_cast<uLong>(raw.size()));
-  std::string packed(packed_size, '\0');
-  if (compress2(reinterpret_cast<Bytef*>(&packed[0]), &packed_size,
-                reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()),
-                Z_DEFAULT_COMPRESSION) != Z_OK) {
-    throw std::runtime_error(path + ": zlib compression failed");
-  }
-  packed.resize(packed_size);
+  const std::string a = deflate(path, plain);
+  const std::string b = deflate(path, filtered);
+  const std::string& packed = a.size() <= b.size() ? a : b;
 
   std::string ihdr;
   putBe32(&ihdr, static_cast<std::uint32_t>(image.width));
