@@ -37,7 +37,8 @@ std::vector<std::string> DenseGridParams::validate() const {
     os << name << " (" << v << ") must be " << rule;
     errors.push_back(os.str());
   };
-  if (!(resolution > 0.001 && resolution <= 100.0)) fail("resolution", resolution, "in (0.001, 100]");
+  if (!(resolution > 0.001 && resolution <= 100.0))
+    fail("resolution", resolution, "in (0.001, 100]");
   if (!(hit_log_odds > 0.0 && hit_log_odds <= kMaxAbsLogOdds)) {
     fail("hit_log_odds", hit_log_odds, "in (0, 7.9]");
   }
@@ -156,8 +157,9 @@ DenseIntegrateStats DenseGrid::integrate(const Pose2& sensor_pose, const ScanVie
     min_y = std::min(min_y, fy[i]);
     max_y = std::max(max_y, fy[i]);
   }
-  growToCover(static_cast<std::int64_t>(std::floor(min_x)), static_cast<std::int64_t>(std::floor(min_y)),
-              static_cast<std::int64_t>(std::floor(max_x)), static_cast<std::int64_t>(std::floor(max_y)));
+  growToCover(
+      static_cast<std::int64_t>(std::floor(min_x)), static_cast<std::int64_t>(std::floor(min_y)),
+      static_cast<std::int64_t>(std::floor(max_x)), static_cast<std::int64_t>(std::floor(max_y)));
 
   // Fixed-point coordinates relative to the grid origin; all non-negative after growToCover.
   const double sub = static_cast<double>(kSubOne);

@@ -5,6 +5,7 @@
 // colouring the disagreeing cells. Single-threaded; run by `make compare` (issue 6).
 #include <malloc.h>
 #include <octomap/OcTree.h>
+#include <sys/stat.h>
 #include <sys/utsname.h>
 #include <unistd.h>
 
@@ -24,7 +25,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <sys/stat.h>
 #include <vector>
 
 #include "wavog_mapping/baseline/dense_grid.h"
@@ -71,8 +71,8 @@ struct Scan {
 };
 
 struct Workload {
-  std::string name;      ///< short name for files
-  std::string label;     ///< table label
+  std::string name;   ///< short name for files
+  std::string label;  ///< table label
   double resolution = 0.05;
   std::vector<Scan> scans;
   std::size_t timed_scans = 0;  ///< scans per timed repetition (a prefix of `scans`)
@@ -105,7 +105,7 @@ double arenaRadius(double phi) {
 
 /// Distance from p along direction (ux, uy) to the arena boundary; p within 5 m of the centre.
 double castToArena(double px, double py, double ux, double uy) {
-  double lo = 40.0;  // inside: |p + lo u| <= 45 < 61.5
+  double lo = 40.0;   // inside: |p + lo u| <= 45 < 61.5
   double hi = 100.0;  // outside: |p + hi u| >= 95 > 78.5
   for (int it = 0; it < 40; ++it) {
     const double mid = 0.5 * (lo + hi);
@@ -127,8 +127,8 @@ std::vector<Scan> syntheticLms291x4(int steps) {
   struct Mount {
     double x, y, yaw;
   };
-  const Mount mounts[4] = {{1.0, 0.0, 0.0}, {-1.0, 0.0, M_PI}, {0.0, 0.5, M_PI / 2},
-                           {0.0, -0.5, -M_PI / 2}};
+  const Mount mounts[4] = {
+      {1.0, 0.0, 0.0}, {-1.0, 0.0, M_PI}, {0.0, 0.5, M_PI / 2}, {0.0, -0.5, -M_PI / 2}};
   constexpr int kBeams = 361;
   const double increment = M_PI / 360.0;
   std::mt19937 rng(20070101);
@@ -215,7 +215,8 @@ class WavogSubject : public Subject {
 /// it, so OctoMap clears free space up to maxrange and marks no hit).
 class OctoMapSubject : public Subject {
  public:
-  OctoMapSubject(double resolution, double no_return_clear) : tree_(resolution), clear_(no_return_clear) {
+  OctoMapSubject(double resolution, double no_return_clear)
+      : tree_(resolution), clear_(no_return_clear) {
     tree_.setProbHit(0.7);
     tree_.setProbMiss(0.4);
     tree_.setClampingThresMin(0.12);
@@ -257,7 +258,8 @@ class OctoMapSubject : public Subject {
     forEachLeafInLayer([&](std::int64_t x0, std::int64_t y0, std::int64_t n, double lo) {
       for (std::int64_t y = std::max(y0, box.min_y); y < std::min(y0 + n, box.max_y); ++y) {
         for (std::int64_t x = std::max(x0, box.min_x); x < std::min(x0 + n, box.max_x); ++x) {
-          out[static_cast<std::size_t>((y - box.min_y) * box.width() + (x - box.min_x))] = classOf(lo);
+          out[static_cast<std::size_t>((y - box.min_y) * box.width() + (x - box.min_x))] =
+              classOf(lo);
         }
       }
     });
@@ -354,14 +356,14 @@ enum SubjectId { kWavogClamp = 0, kWavogForget = 1, kOctoMap = 2, kDense = 3, kS
 const char* const kSubjectNames[kSubjects] = {"wavog-clamp", "wavog-forget", "OctoMap", "dense"};
 
 struct SubjectResult {
-  double scans_per_s = 0.0;            ///< median over the repetitions
-  double min_s = 0.0, max_s = 0.0;     ///< spread of the repetition times (s)
+  double scans_per_s = 0.0;         ///< median over the repetitions
+  double min_s = 0.0, max_s = 0.0;  ///< spread of the repetition times (s)
   std::vector<double> rep_seconds;
-  double warmup_s = 0.0;               ///< the warm-up run (all scans)
+  double warmup_s = 0.0;  ///< the warm-up run (all scans)
   std::size_t own_bytes = 0;
   std::size_t rss_growth = 0;
   std::uint64_t observed = 0;
-  double work_per_scan = 0.0;          ///< nodes visited / cells updated per scan (warm-up run)
+  double work_per_scan = 0.0;  ///< nodes visited / cells updated per scan (warm-up run)
 };
 
 struct PairAgreement {
@@ -370,7 +372,9 @@ struct PairAgreement {
   std::uint64_t a_occ_b_free = 0;
   std::uint64_t a_free_b_occ = 0;
   std::uint64_t undecided = 0;  ///< one side exactly at p = 0.5
-  double share() const { return common == 0 ? 0.0 : static_cast<double>(same) / static_cast<double>(common); }
+  double share() const {
+    return common == 0 ? 0.0 : static_cast<double>(same) / static_cast<double>(common);
+  }
 };
 
 struct WorkloadResult {
@@ -442,7 +446,8 @@ const wavog::Rgb kColWavogOcc{230, 30, 30};      // wavog occupied, other free: 
 const wavog::Rgb kColWavogFree{30, 90, 230};     // wavog free, other occupied: blue
 const wavog::Rgb kColHalf{240, 180, 0};          // one side at exactly p = 0.5: amber
 
-wavog::Image disagreementImage(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b,
+wavog::Image disagreementImage(const std::vector<std::uint8_t>& a,
+                               const std::vector<std::uint8_t>& b,
                                const std::vector<std::uint8_t>& all3, const wavog::CellBox& box,
                                const wavog::CellBox& crop, int upscale) {
   const int w = static_cast<int>(crop.width());
@@ -454,7 +459,8 @@ wavog::Image disagreementImage(const std::vector<std::uint8_t>& a, const std::ve
       const std::int64_t x = crop.min_x + col;
       wavog::Rgb colour = kColUnobserved;
       if (x >= box.min_x && x < box.max_x && y >= box.min_y && y < box.max_y) {
-        const std::size_t i = static_cast<std::size_t>((y - box.min_y) * box.width() + (x - box.min_x));
+        const std::size_t i =
+            static_cast<std::size_t>((y - box.min_y) * box.width() + (x - box.min_x));
         if (all3[i] == 0) {
           colour = (a[i] != kUnobs || b[i] != kUnobs) ? kColPartly : kColUnobserved;
         } else if (a[i] == b[i]) {
@@ -496,7 +502,8 @@ wavog::CellBox densestDisagreement(const std::vector<std::uint8_t>& a,
       const std::int64_t d = (all3[i] != 0 && a[i] != b[i]) ? 1 : 0;
       sat[static_cast<std::size_t>((y + 1) * (w + 1) + x + 1)] =
           d + sat[static_cast<std::size_t>(y * (w + 1) + x + 1)] +
-          sat[static_cast<std::size_t>((y + 1) * (w + 1) + x)] - sat[static_cast<std::size_t>(y * (w + 1) + x)];
+          sat[static_cast<std::size_t>((y + 1) * (w + 1) + x)] -
+          sat[static_cast<std::size_t>(y * (w + 1) + x)];
     }
   }
   std::int64_t best = -1, bx = 0, by = 0;
@@ -514,7 +521,8 @@ wavog::CellBox densestDisagreement(const std::vector<std::uint8_t>& a,
       }
     }
   }
-  return wavog::CellBox{box.min_x + bx, box.min_y + by, box.min_x + bx + crop, box.min_y + by + crop};
+  return wavog::CellBox{box.min_x + bx, box.min_y + by, box.min_x + bx + crop,
+                        box.min_y + by + crop};
 }
 
 /// Runs every structure on one workload.
@@ -547,7 +555,9 @@ WorkloadResult runWorkload(const Workload& wl, const Options& opt) {
   const std::function<std::unique_ptr<Subject>()> make[kSubjects] = {
       [&] { return std::unique_ptr<Subject>(new WavogSubject(clamp)); },
       [&] { return std::unique_ptr<Subject>(new WavogSubject(forget)); },
-      [&] { return std::unique_ptr<Subject>(new OctoMapSubject(wl.resolution, opt.no_return_clear)); },
+      [&] {
+        return std::unique_ptr<Subject>(new OctoMapSubject(wl.resolution, opt.no_return_clear));
+      },
       [&] { return std::unique_ptr<Subject>(new DenseSubject(dense, dense_presize)); },
   };
 
@@ -587,9 +597,9 @@ WorkloadResult runWorkload(const Workload& wl, const Options& opt) {
     r.min_s = *std::min_element(r.rep_seconds.begin(), r.rep_seconds.end());
     r.max_s = *std::max_element(r.rep_seconds.begin(), r.rep_seconds.end());
     std::cerr << "  " << std::setw(12) << kSubjectNames[k] << ": " << std::fixed
-              << std::setprecision(1) << r.scans_per_s << " scans/s (warm-up " << std::setprecision(2)
-              << r.warmup_s << " s), " << r.own_bytes << " B own, " << r.rss_growth << " B RSS, "
-              << r.observed << " observed cells" << std::endl;
+              << std::setprecision(1) << r.scans_per_s << " scans/s (warm-up "
+              << std::setprecision(2) << r.warmup_s << " s), " << r.own_bytes << " B own, "
+              << r.rss_growth << " B RSS, " << r.observed << " observed cells" << std::endl;
   }
 
   // Agreement over the cells all three kinds observed, inside the dense grid's observed box.
@@ -606,7 +616,10 @@ WorkloadResult runWorkload(const Workload& wl, const Options& opt) {
   // Pictures: cells observed by all three; disagreements of wavog-clamp against each other map.
   std::vector<std::uint8_t> all3(cls[kDense].size(), 0);
   for (std::size_t i = 0; i < all3.size(); ++i) {
-    all3[i] = (cls[kWavogClamp][i] != kUnobs && cls[kOctoMap][i] != kUnobs && cls[kDense][i] != kUnobs) ? 1 : 0;
+    all3[i] =
+        (cls[kWavogClamp][i] != kUnobs && cls[kOctoMap][i] != kUnobs && cls[kDense][i] != kUnobs)
+            ? 1
+            : 0;
   }
   const std::string stem = opt.out_dir + "/disagree_" + wl.name;
   const struct {
@@ -615,12 +628,14 @@ WorkloadResult runWorkload(const Workload& wl, const Options& opt) {
   } pairs[2] = {{kOctoMap, "octomap"}, {kDense, "dense"}};
   for (const auto& pr : pairs) {
     const std::string full_path = stem + "_vs_" + pr.suffix + ".png";
-    wavog::writePng(full_path, disagreementImage(cls[kWavogClamp], cls[pr.other], all3, box, box, 1));
+    wavog::writePng(full_path,
+                    disagreementImage(cls[kWavogClamp], cls[pr.other], all3, box, box, 1));
     res.pictures.push_back(full_path);
     const wavog::CellBox crop =
         densestDisagreement(cls[kWavogClamp], cls[pr.other], all3, box, opt.crop_cells);
     const std::string crop_path = stem + "_vs_" + pr.suffix + "_zoom.png";
-    wavog::writePng(crop_path, disagreementImage(cls[kWavogClamp], cls[pr.other], all3, box, crop, 3));
+    wavog::writePng(crop_path,
+                    disagreementImage(cls[kWavogClamp], cls[pr.other], all3, box, crop, 3));
     res.pictures.push_back(crop_path);
   }
   return res;
@@ -635,7 +650,9 @@ std::string fmt(double v, int precision) {
   return os.str();
 }
 
-std::string pct(const PairAgreement& p) { return p.common == 0 ? "n/a" : fmt(100.0 * p.share(), 2) + " %"; }
+std::string pct(const PairAgreement& p) {
+  return p.common == 0 ? "n/a" : fmt(100.0 * p.share(), 2) + " %";
+}
 
 double perCell(std::size_t bytes, std::uint64_t cells) {
   return cells == 0 ? 0.0 : static_cast<double>(bytes) / static_cast<double>(cells);
@@ -686,9 +703,9 @@ std::string report(const std::vector<WorkloadResult>& results, const Options& op
     const SubjectResult* s = r.subject;
     os << "| " << r.label << " | " << fmt(r.resolution * 100, 0) << " cm | " << r.timed_scans
        << (r.timed_scans < r.scans ? " of " + std::to_string(r.scans) : "") << " | "
-       << fmt(s[kWavogClamp].scans_per_s, 0) << " | " << fmt(s[kWavogForget].scans_per_s, 0) << " | "
-       << fmt(s[kOctoMap].scans_per_s, 1) << " | " << fmt(s[kDense].scans_per_s, 0) << " | "
-       << fmt(s[kWavogClamp].scans_per_s / s[kOctoMap].scans_per_s, 1) << "x | "
+       << fmt(s[kWavogClamp].scans_per_s, 0) << " | " << fmt(s[kWavogForget].scans_per_s, 0)
+       << " | " << fmt(s[kOctoMap].scans_per_s, 1) << " | " << fmt(s[kDense].scans_per_s, 0)
+       << " | " << fmt(s[kWavogClamp].scans_per_s / s[kOctoMap].scans_per_s, 1) << "x | "
        << fmt(s[kWavogClamp].scans_per_s / s[kDense].scans_per_s, 2) << "x | "
        << fmt(s[kWavogForget].scans_per_s / s[kOctoMap].scans_per_s, 1) << "x | "
        << fmt(s[kWavogForget].scans_per_s / s[kDense].scans_per_s, 2) << "x |\n";
@@ -711,15 +728,17 @@ std::string report(const std::vector<WorkloadResult>& results, const Options& op
     const SubjectResult* s = r.subject;
     os << "| " << r.label << " | " << fmt(r.resolution * 100, 0) << " cm | "
        << s[kWavogClamp].observed << " / " << s[kOctoMap].observed << " / " << s[kDense].observed
-       << " | " << fmt(s[kWavogClamp].own_bytes / 1e6, 2) << " / " << fmt(s[kWavogForget].own_bytes / 1e6, 2)
-       << " / " << fmt(s[kOctoMap].own_bytes / 1e6, 2) << " / " << fmt(s[kDense].own_bytes / 1e6, 2)
-       << " |";
+       << " | " << fmt(s[kWavogClamp].own_bytes / 1e6, 2) << " / "
+       << fmt(s[kWavogForget].own_bytes / 1e6, 2) << " / " << fmt(s[kOctoMap].own_bytes / 1e6, 2)
+       << " / " << fmt(s[kDense].own_bytes / 1e6, 2) << " |";
     for (int k = 0; k < kSubjects; ++k) {
       os << " " << fmt(perCell(s[k].own_bytes, s[k].observed), 2) << " / "
          << fmt(perCell(s[k].rss_growth, s[k].observed), 2) << " |";
     }
-    os << " " << fmt(perCell(s[kOctoMap].own_bytes, s[kOctoMap].observed) /
-                         perCell(s[kWavogClamp].own_bytes, s[kWavogClamp].observed), 1)
+    os << " "
+       << fmt(perCell(s[kOctoMap].own_bytes, s[kOctoMap].observed) /
+                  perCell(s[kWavogClamp].own_bytes, s[kWavogClamp].observed),
+              1)
        << "x |\n";
   }
   os << "\nObserved cells are each structure's own count: wavog's sector model observes the whole "
@@ -731,11 +750,12 @@ std::string report(const std::vector<WorkloadResult>& results, const Options& op
         "clamp occ / dense free | clamp free / dense occ |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const WorkloadResult& r : results) {
-    os << "| " << r.label << " | " << fmt(r.resolution * 100, 0) << " cm | " << r.clamp_octomap.common
-       << " | " << pct(r.clamp_octomap) << " | " << pct(r.clamp_dense) << " | " << pct(r.octomap_dense)
-       << " | " << pct(r.forget_octomap) << " | " << pct(r.forget_dense) << " | "
-       << r.clamp_octomap.a_occ_b_free << " | " << r.clamp_octomap.a_free_b_occ << " | "
-       << r.clamp_dense.a_occ_b_free << " | " << r.clamp_dense.a_free_b_occ << " |\n";
+    os << "| " << r.label << " | " << fmt(r.resolution * 100, 0) << " cm | "
+       << r.clamp_octomap.common << " | " << pct(r.clamp_octomap) << " | " << pct(r.clamp_dense)
+       << " | " << pct(r.octomap_dense) << " | " << pct(r.forget_octomap) << " | "
+       << pct(r.forget_dense) << " | " << r.clamp_octomap.a_occ_b_free << " | "
+       << r.clamp_octomap.a_free_b_occ << " | " << r.clamp_dense.a_occ_b_free << " | "
+       << r.clamp_dense.a_free_b_occ << " |\n";
   }
   os << "\n### Targets (issue 6; wavog-clamp unless stated)\n\n";
   const auto find = [&results](const std::string& name, double res) -> const WorkloadResult* {
@@ -776,13 +796,14 @@ std::string report(const std::vector<WorkloadResult>& results, const Options& op
        << ", " << verdict(r.clamp_octomap.share() >= 0.95 && r.clamp_dense.share() >= 0.95) << "\n";
   }
   os << "\n### Repetition times (s: min / median / max)\n\n"
-     << "| workload | res | wavog-clamp | wavog-forget | OctoMap | dense |\n|---|---|---|---|---|---|\n";
+     << "| workload | res | wavog-clamp | wavog-forget | OctoMap | dense "
+        "|\n|---|---|---|---|---|---|\n";
   for (const WorkloadResult& r : results) {
     os << "| " << r.label << " | " << fmt(r.resolution * 100, 0) << " cm |";
     for (int k = 0; k < kSubjects; ++k) {
       const SubjectResult& s = r.subject[k];
-      os << " " << fmt(s.min_s, 3) << " / " << fmt(median(s.rep_seconds), 3) << " / " << fmt(s.max_s, 3)
-         << " |";
+      os << " " << fmt(s.min_s, 3) << " / " << fmt(median(s.rep_seconds), 3) << " / "
+         << fmt(s.max_s, 3) << " |";
     }
     os << "\n";
   }
@@ -807,13 +828,16 @@ void usage() {
          "  --resolutions LIST    cell sizes in m (default 0.05,0.1)\n"
          "  --reps N              timed repetitions after the warm-up, >= 1 (default 5)\n"
          "  --max-scans N         scans taken from each log, 0 = all (default 0)\n"
-         "  --stride LIST         take every N-th scan of a log, e.g. fr079=8,csail=14 (default 1)\n"
+         "  --stride LIST         take every N-th scan of a log, e.g. fr079=8,csail=14 (default "
+         "1)\n"
          "  --timed-scans N       scans per timed repetition (a prefix), 0 = all (default 0)\n"
          "  --synthetic-steps N   steps of the four-LMS-291 workload, 4 scans each (default 25)\n"
          "  --no-return-clear M   no-return beams clear free space up to M metres, 0 = not at all\n"
          "                        (default 80; OctoMap's maxrange)\n"
-         "  --crop N              cells per side of the zoomed disagreement pictures (default 200)\n"
-         "  --data DIR            directory of the CARMEN logs (default: found from ../shared/data)\n"
+         "  --crop N              cells per side of the zoomed disagreement pictures (default "
+         "200)\n"
+         "  --data DIR            directory of the CARMEN logs (default: found from "
+         "../shared/data)\n"
          "  --out DIR             output directory (default compare_output)\n"
          "  --smoke               tiny workload, 1 repetition: a test that the program runs\n";
 }
@@ -871,7 +895,8 @@ int main(int argc, char** argv) {
       }
     }
     if (opt.reps < 1 || opt.synthetic_steps < 1 || opt.no_return_clear < 0 || opt.crop_cells < 8) {
-      throw std::invalid_argument("--reps, --synthetic-steps >= 1, --no-return-clear >= 0, --crop >= 8");
+      throw std::invalid_argument(
+          "--reps, --synthetic-steps >= 1, --no-return-clear >= 0, --crop >= 8");
     }
   } catch (const std::exception& e) {
     std::cerr << "wavog_compare: " << e.what() << "\n";
@@ -894,7 +919,8 @@ int main(int argc, char** argv) {
       std::vector<Scan> scans;
       std::string label;
       if (w == "fr079" || w == "csail") {
-        const std::string file = w == "fr079" ? "fr079-corrected.log.gz" : "csail-robotlaser1.log.gz";
+        const std::string file =
+            w == "fr079" ? "fr079-corrected.log.gz" : "csail-robotlaser1.log.gz";
         if (opt.data_dir.empty()) {
           if (opt.smoke) {
             std::cerr << "wavog_compare: no data directory; skipping " << w << "\n";
@@ -918,7 +944,8 @@ int main(int argc, char** argv) {
         wl.label = label;
         wl.resolution = res;
         wl.scans = scans;
-        wl.timed_scans = opt.timed_scans == 0 ? scans.size() : std::min(opt.timed_scans, scans.size());
+        wl.timed_scans =
+            opt.timed_scans == 0 ? scans.size() : std::min(opt.timed_scans, scans.size());
         std::cerr << wl.name << ": " << wl.scans.size() << " scans, " << wl.timed_scans
                   << " timed per repetition" << std::endl;
         results.push_back(runWorkload(wl, opt));

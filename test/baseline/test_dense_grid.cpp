@@ -223,8 +223,8 @@ TEST(DenseGrid, IntegerDdaVisitsExactlyTheCellsTheSegmentCrosses) {
     const double ax = pose.x / kRes, ay = pose.y / kRes;
     const double bx = ax + r / kRes * std::cos(pose.theta);
     const double by = ay + r / kRes * std::sin(pose.theta);
-    const CellIndex end = grid.cellAt(pose.x + r * std::cos(pose.theta),
-                                      pose.y + r * std::sin(pose.theta));
+    const CellIndex end =
+        grid.cellAt(pose.x + r * std::cos(pose.theta), pose.y + r * std::sin(pose.theta));
     const CellIndex start = grid.cellAt(pose.x, pose.y);
     const wavog::CellBox box = grid.extent();
     std::uint64_t free_cells = 0;

@@ -100,8 +100,7 @@ class DenseGrid {
   };
 
   /// Makes the grid cover cells [min_x, max_x] x [min_y, max_y] (inclusive), keeping the contents.
-  void growToCover(std::int64_t min_x, std::int64_t min_y, std::int64_t max_x,
-                   std::int64_t max_y);
+  void growToCover(std::int64_t min_x, std::int64_t min_y, std::int64_t max_x, std::int64_t max_y);
   /// Starts a new scan: next stamp; stamps wrap by clearing every cell's stamp.
   void nextStamp();
   /// Applies the miss update to every cell from `start` up to, not including, the cell of `end`.
@@ -117,7 +116,7 @@ class DenseGrid {
   std::int16_t clamp_min_;
   std::int16_t clamp_max_;
 
-  std::vector<Cell> cells_;  // row-major, width_ x height_
+  std::vector<Cell> cells_;    // row-major, width_ x height_
   std::int64_t origin_x_ = 0;  // cell index of cells_[0]
   std::int64_t origin_y_ = 0;
   std::int64_t width_ = 0;
