@@ -672,6 +672,19 @@ std::string readFirstLine(const std::string& path, const std::string& key) {
   return "unknown";
 }
 
+/// Commit of the source tree (with "+dirty" when it has local changes), or "unknown".
+std::string sourceCommit() {
+  const std::string cmd = std::string("git -C '") + WAVOG_SOURCE_DIR +
+                          "' describe --always --dirty=+dirty --abbrev=10 2>/dev/null";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return "unknown";
+  char buf[128] = {0};
+  std::string out = fgets(buf, sizeof(buf), pipe) != nullptr ? std::string(buf) : "";
+  pclose(pipe);
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out.empty() ? "unknown" : out;
+}
+
 std::string machineDescription() {
   std::ostringstream os;
   utsname u{};
@@ -688,6 +701,7 @@ std::string machineDescription() {
      << readFirstLine("/etc/os-release", "PRETTY_NAME") << "\n"
      << "- Compiler: GCC " << __VERSION__ << ", build type " << WAVOG_COMPARE_BUILD_TYPE
      << ", no -march=native; OctoMap " << WAVOG_OCTOMAP_VERSION << " (Debian liboctomap-dev)\n"
+     << "- Source: commit " << sourceCommit() << "\n"
      << "- Run: " << when << ", load average at the end " << fmt(load[0], 2) << " / "
      << fmt(load[1], 2) << " / " << fmt(load[2], 2) << " (1/5/15 min)\n";
   return os.str();
