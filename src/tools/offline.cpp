@@ -475,7 +475,8 @@ InputInfo runCarmen(const Options& o, const wavog_ros::Config& config,
   wavog::CarmenReader reader(o.input, false);
   wavog::CarmenScan scan;
   try {
-    while (s.done() < total && reader.next(&scan)) {
+    // Read on to the end (not just `total` scans), so that a truncated stream is reported.
+    while ((o.max_scans == 0 || s.done() < o.max_scans) && reader.next(&scan)) {
       if (plan.laserFor(scan.type) == nullptr) continue;
       s.integrate(scan.laser_pose, scan.view(0.0), scan.ipc_timestamp);
     }

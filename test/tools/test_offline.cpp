@@ -300,6 +300,24 @@ TEST(Offline, LaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) {
   EXPECT_LE(map.value(map.cellAt(0.0, 0.0)), 0.0f);
 }
 
+TEST(Offline, TruncatedGzipLogIsReportedAfterMappingWhatWasRead) {
+  const std::string src = dataFile("fr079-corrected.log.gz");
+  ASSERT_FALSE(src.empty());
+  std::ifstream in(src, std::ios::binary);
+  std::string bytes(120000, '\0');  // about 270 scans
+  in.read(&bytes[0], static_cast<std::streamsize>(bytes.size()));
+  const std::string cut = (workDir() / "cut.log.gz").string();
+  std::ofstream(cut, std::ios::binary) << bytes;
+  const std::string out = (workDir() / "cut").string();
+  const RunResult r = run(WAVOG_OFFLINE, "--no-progress -o " + out + " " + cut);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("error: " + cut + ": truncated gzip stream"), std::string::npos) << r.err;
+  const std::string json = readText(fs::path(out) / "summary.json");
+  EXPECT_NE(json.find("\"read_error\": \"" + cut + ": truncated gzip stream"), std::string::npos)
+      << json;
+  EXPECT_TRUE(fs::exists(fs::path(out) / "map_s0.png"));
+}
+
 TEST(Offline, ClearErrors) {
   const std::string out = (workDir() / "errors").string();
   const std::string missing = (workDir() / "missing.bag").string();
