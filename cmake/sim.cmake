@@ -44,3 +44,15 @@ target_link_libraries(wavog_evaluate PRIVATE wavog_sim_eval wavog_io Threads::Th
 target_compile_options(wavog_evaluate PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_evaluate PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_SIM_BIN_DIR})
 install(TARGETS wavog_evaluate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+# The bag end to end (rosbag API; maps it with wavog_offline when that is built).
+wavog_sim_test(test_simulate_bag wavog_sim)
+target_include_directories(test_simulate_bag SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(test_simulate_bag PRIVATE ${catkin_LIBRARIES})
+target_compile_definitions(test_simulate_bag PRIVATE
+  WAVOG_SIMULATE="$<TARGET_FILE:wavog_simulate>" WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+add_dependencies(test_simulate_bag wavog_simulate)
+if(TARGET wavog_offline)
+  target_compile_definitions(test_simulate_bag PRIVATE WAVOG_OFFLINE="$<TARGET_FILE:wavog_offline>")
+  add_dependencies(test_simulate_bag wavog_offline)
+endif()
