@@ -352,14 +352,24 @@ double seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
+/// CPU time consumed by the calling thread (s), user + system: unlike wall-clock time it does not
+/// count the time the thread waits for a core that other processes hold.
+double threadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 enum SubjectId { kWavogClamp = 0, kWavogForget = 1, kOctoMap = 2, kDense = 3, kSubjects = 4 };
 const char* const kSubjectNames[kSubjects] = {"wavog-clamp", "wavog-forget", "OctoMap", "dense"};
 
 struct SubjectResult {
-  double scans_per_s = 0.0;         ///< median over the repetitions
-  double min_s = 0.0, max_s = 0.0;  ///< spread of the repetition times (s)
-  std::vector<double> rep_seconds;
-  double warmup_s = 0.0;  ///< the warm-up run (all scans)
+  double scans_per_s = 0.0;         ///< by the median thread CPU time of the repetitions
+  double scans_per_s_wall = 0.0;    ///< by the median wall-clock time of the repetitions
+  double min_s = 0.0, max_s = 0.0;  ///< spread of the repetition CPU times (s)
+  std::vector<double> rep_seconds;  ///< thread CPU time of each repetition (s)
+  std::vector<double> rep_wall;     ///< wall-clock time of each repetition (s)
+  double warmup_s = 0.0;            ///< the warm-up run (all scans)
   std::size_t own_bytes = 0;
   std::size_t rss_growth = 0;
   std::uint64_t observed = 0;
@@ -586,14 +596,18 @@ WorkloadResult runWorkload(const Workload& wl, const Options& opt) {
     for (int k = 0; k < kSubjects; ++k) {
       std::unique_ptr<Subject> m = make[k]();
       const auto a = Clock::now();
+      const double ca = threadCpuSeconds();
       for (std::size_t i = 0; i < wl.timed_scans; ++i) m->integrate(wl.scans[i]);
+      const double cb = threadCpuSeconds();
       const auto b = Clock::now();
-      res.subject[k].rep_seconds.push_back(seconds(a, b));
+      res.subject[k].rep_seconds.push_back(cb - ca);
+      res.subject[k].rep_wall.push_back(seconds(a, b));
     }
   }
   for (int k = 0; k < kSubjects; ++k) {
     SubjectResult& r = res.subject[k];
     r.scans_per_s = static_cast<double>(wl.timed_scans) / median(r.rep_seconds);
+    r.scans_per_s_wall = static_cast<double>(wl.timed_scans) / median(r.rep_wall);
     r.min_s = *std::min_element(r.rep_seconds.begin(), r.rep_seconds.end());
     r.max_s = *std::max_element(r.rep_seconds.begin(), r.rep_seconds.end());
     std::cerr << "  " << std::setw(12) << kSubjectNames[k] << ": " << std::fixed
@@ -709,7 +723,8 @@ std::string machineDescription() {
 
 std::string report(const std::vector<WorkloadResult>& results, const Options& opt) {
   std::ostringstream os;
-  os << "### Speed (scans/s, median of " << opt.reps << " repetitions after a warm-up)\n\n"
+  os << "### Speed (scans/s by thread CPU time, median of " << opt.reps
+     << " repetitions after a warm-up)\n\n"
      << "| workload | res | scans timed | wavog-clamp | wavog-forget | OctoMap | dense | "
         "clamp/OctoMap | clamp/dense | forget/OctoMap | forget/dense |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -809,18 +824,26 @@ std::string report(const std::vector<WorkloadResult>& results, const Options& op
        << " cm: with OctoMap " << pct(r.clamp_octomap) << ", with dense " << pct(r.clamp_dense)
        << ", " << verdict(r.clamp_octomap.share() >= 0.95 && r.clamp_dense.share() >= 0.95) << "\n";
   }
-  os << "\n### Repetition times (s: min / median / max)\n\n"
-     << "| workload | res | wavog-clamp | wavog-forget | OctoMap | dense "
-        "|\n|---|---|---|---|---|---|\n";
+  os << "\n### Repetition times (thread CPU s: min / median / max; wall-clock median)\n\n"
+     << "| workload | res | wavog-clamp | wavog-forget | OctoMap | dense | CPU share | "
+        "clamp/OctoMap wall | clamp/dense wall |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const WorkloadResult& r : results) {
     os << "| " << r.label << " | " << fmt(r.resolution * 100, 0) << " cm |";
+    double cpu = 0.0, wall = 0.0;
     for (int k = 0; k < kSubjects; ++k) {
       const SubjectResult& s = r.subject[k];
       os << " " << fmt(s.min_s, 3) << " / " << fmt(median(s.rep_seconds), 3) << " / "
-         << fmt(s.max_s, 3) << " |";
+         << fmt(s.max_s, 3) << "; " << fmt(median(s.rep_wall), 3) << " |";
+      for (double v : s.rep_seconds) cpu += v;
+      for (double v : s.rep_wall) wall += v;
     }
-    os << "\n";
+    const SubjectResult* s = r.subject;
+    os << " " << fmt(wall > 0 ? 100.0 * cpu / wall : 0.0, 0) << " % | "
+       << fmt(s[kWavogClamp].scans_per_s_wall / s[kOctoMap].scans_per_s_wall, 1) << "x | "
+       << fmt(s[kWavogClamp].scans_per_s_wall / s[kDense].scans_per_s_wall, 2) << "x |\n";
   }
+  os << "\nCPU share: thread CPU time over wall-clock time of all timed runs (below 100 % when "
+        "other processes held the cores).\n";
   os << "\nMachine:\n\n" << machineDescription() << "\nCommand: `" << opt.command << "`\n";
   return os.str();
 }
@@ -979,15 +1002,16 @@ int main(int argc, char** argv) {
   std::ofstream md(opt.out_dir + "/results.md");
   md << text;
   std::ofstream csv(opt.out_dir + "/results.csv");
-  csv << "workload,resolution_m,scans,timed_scans,structure,scans_per_s,rep_min_s,rep_max_s,"
+  csv << "workload,resolution_m,scans,timed_scans,structure,scans_per_s_cpu,scans_per_s_wall,"
+         "rep_min_cpu_s,rep_max_cpu_s,"
          "warmup_s,own_bytes,rss_growth_bytes,observed_cells,work_per_scan\n";
   for (const WorkloadResult& r : results) {
     for (int k = 0; k < kSubjects; ++k) {
       const SubjectResult& s = r.subject[k];
       csv << r.name << "," << r.resolution << "," << r.scans << "," << r.timed_scans << ","
-          << kSubjectNames[k] << "," << s.scans_per_s << "," << s.min_s << "," << s.max_s << ","
-          << s.warmup_s << "," << s.own_bytes << "," << s.rss_growth << "," << s.observed << ","
-          << s.work_per_scan << "\n";
+          << kSubjectNames[k] << "," << s.scans_per_s << "," << s.scans_per_s_wall << "," << s.min_s
+          << "," << s.max_s << "," << s.warmup_s << "," << s.own_bytes << "," << s.rss_growth << ","
+          << s.observed << "," << s.work_per_scan << "\n";
     }
   }
   if (!md || !csv) {
