@@ -3,7 +3,7 @@
 # the targets that use catkin variables.
 find_package(catkin REQUIRED COMPONENTS
   roscpp nodelet pluginlib tf2 tf2_ros tf2_eigen sensor_msgs nav_msgs geometry_msgs map_msgs
-  std_msgs std_srvs diagnostic_updater dynamic_reconfigure rosbag message_generation)
+  std_msgs std_srvs diagnostic_updater diagnostic_msgs dynamic_reconfigure rosbag message_generation)
 find_package(yaml-cpp REQUIRED)
 
 add_message_files(DIRECTORY msg FILES InputStatus.msg MapperStatus.msg)
@@ -15,6 +15,7 @@ catkin_package(
   INCLUDE_DIRS include
   LIBRARIES wavog_core wavog_io wavog_ros_config
   CATKIN_DEPENDS roscpp nodelet pluginlib tf2 tf2_ros sensor_msgs nav_msgs geometry_msgs map_msgs
-                 std_msgs std_srvs diagnostic_updater dynamic_reconfigure rosbag message_runtime
+                 std_msgs std_srvs diagnostic_updater diagnostic_msgs dynamic_reconfigure rosbag
+                 message_runtime
   DEPENDS EIGEN3
 )

@@ -1,6 +1,7 @@
 # ROS layer targets (issue 3). Neither is part of `make test`.
-#   make tsan         ThreadSanitizer build of the node in $(BUILD_TSAN) and the integration rostest
-#                     run against it (4 scan inputs + publication timer + services on 4 threads).
+#   make tsan         ThreadSanitizer build of the node in $(BUILD_TSAN); runs the integration and
+#                     bad-input rostests against it (4 scan inputs, tf, timers on 4 threads).
+#                     roscpp-internal reports are suppressed (test/ros/tsan.supp). ~4 min on 2 cores.
 #   make rviz-check   installs rviz + Xvfb (separate from `make deps`), runs rviz/wavog.rviz under
 #                     Xvfb against the integration scene and writes $(RVIZ_SHOT).
 BUILD_TSAN ?= $(ROOT)/build-tsan
@@ -15,12 +16,12 @@ tsan: deps
 	  -DWAVOG_SANITIZE=thread -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  >$(BUILD_TSAN)/configure.log || { cat $(BUILD_TSAN)/configure.log; exit 1; }
 	@cmake --build $(BUILD_TSAN) -j$(JOBS) --target wavog_mapping_node test_mapping_system \
-	  -- --no-print-directory
+	  test_bad_input -- --no-print-directory
 	@rm -f $(BUILD_TSAN)/tsan/report.*
 	@$(ROS_ENV); source $(BUILD_TSAN)/devel/setup.bash; \
 	  export ROS_HOME=$(BUILD_TSAN)/ros_home; \
-	  export TSAN_OPTIONS="log_path=$(BUILD_TSAN)/tsan/report second_deadlock_stack=1 history_size=4"; \
-	  rostest wavog_mapping mapping_node.test
+	  export TSAN_OPTIONS="log_path=$(BUILD_TSAN)/tsan/report second_deadlock_stack=1 history_size=4 suppressions=$(ROOT)/test/ros/tsan.supp"; \
+	  rostest wavog_mapping mapping_node.test && rostest wavog_mapping bad_input.test
 	@if ls $(BUILD_TSAN)/tsan/report.* >/dev/null 2>&1; then \
 	  cat $(BUILD_TSAN)/tsan/report.*; echo "tsan: ThreadSanitizer reports above"; exit 1; \
 	else echo "tsan: no data race reported"; fi

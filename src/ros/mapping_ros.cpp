@@ -158,7 +158,7 @@ struct MappingRos::Impl {
   double publish_time_ = 0.0;
   ros::Time last_status_time_;
   std::uint64_t tf_failures_reported_ = 0;  ///< tf failures at the last diagnostics update
-  // Region touched since the last publication (map frame, m); for map_updates.
+  // Region touched since the last map_updates message (map frame, m).
   bool dirty_ = false;
   double dirty_min_x_ = 0, dirty_min_y_ = 0, dirty_max_x_ = 0, dirty_max_y_ = 0;
   bool have_full_ = false;
@@ -532,9 +532,10 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
                                                          : ros.scale_aggregation)
                        : emptyRaster(job.scale, map_.resolution());
       if (job.scale == 0) {
+        // The dirty region is reset by map_updates only: re-sending an area the full map already
+        // carries is harmless, while two timers of the same period would otherwise starve updates.
         have_full_ = true;
         last_full_box_ = job.raster.box;
-        dirty_ = false;
       }
     }
 

@@ -9,6 +9,8 @@
 #include <mutex>
 #include <thread>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -42,11 +44,32 @@ class Recorder {
     std::lock_guard<std::mutex> lock(mutex_);
     return status_;
   }
+  void onUpdate(const map_msgs::OccupancyGridUpdate::ConstPtr& u) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    update_ = u;
+    update_grid_ = grids_["map"];  // the full grid the update refers to
+  }
+  void update(map_msgs::OccupancyGridUpdate::ConstPtr* u, nav_msgs::OccupancyGrid::ConstPtr* g) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    *u = update_;
+    *g = update_grid_;
+  }
+  void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& d) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& s : d->status) diagnostics_[s.name] = s;
+  }
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> diagnostics() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return diagnostics_;
+  }
 
  private:
   std::mutex mutex_;
   std::map<std::string, nav_msgs::OccupancyGrid::ConstPtr> grids_;
   wavog_mapping::MapperStatus::ConstPtr status_;
+  map_msgs::OccupancyGridUpdate::ConstPtr update_;
+  nav_msgs::OccupancyGrid::ConstPtr update_grid_;
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> diagnostics_;
 };
 
 Recorder* g_recorder = nullptr;
@@ -133,6 +156,56 @@ TEST(MappingSystem, StatusCounters) {
   EXPECT_GE(s->integrate_time_max, s->integrate_time_mean);
 }
 
+TEST(MappingSystem, MapUpdatesLieInsideTheFullGrid) {
+  map_msgs::OccupancyGridUpdate::ConstPtr u;
+  nav_msgs::OccupancyGrid::ConstPtr g;
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20.0);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    g_recorder->update(&u, &g);
+    if (u && g) break;
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_TRUE(u && g);
+  EXPECT_EQ(u->header.frame_id, "map");
+  EXPECT_GT(u->width, 0u);
+  EXPECT_GT(u->height, 0u);
+  EXPECT_EQ(u->data.size(), static_cast<std::size_t>(u->width) * u->height);
+  EXPECT_GE(u->x, 0);
+  EXPECT_GE(u->y, 0);
+  EXPECT_LE(u->x + static_cast<int>(u->width), static_cast<int>(g->info.width));
+  EXPECT_LE(u->y + static_cast<int>(u->height), static_cast<int>(g->info.height));
+  // The scanners see the whole room: the update is smaller than the grid, yet covers the room.
+  EXPECT_LT(static_cast<std::size_t>(u->width) * u->height, g->data.size());
+}
+
+TEST(MappingSystem, DiagnosticsPerInputAndMapper) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20.0);
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> d;
+  while (ros::ok() && ros::WallTime::now() < end) {
+    d = g_recorder->diagnostics();
+    if (d.size() >= 9) break;
+    ros::WallDuration(0.05).sleep();
+  }
+  std::string names;
+  for (const auto& kv : d) names += kv.first + "; ";
+  for (int i = 1; i <= 4; ++i) {
+    const std::string topic = "/scan_" + std::to_string(i);
+    bool input = false, rate = false;
+    for (const auto& kv : d) {
+      if (kv.first.find(topic + " input") != std::string::npos) {
+        input = true;
+        EXPECT_EQ(kv.second.level, diagnostic_msgs::DiagnosticStatus::OK) << kv.second.message;
+      }
+      if (kv.first.find(topic + " rate") != std::string::npos) rate = true;
+    }
+    EXPECT_TRUE(input) << names;
+    EXPECT_TRUE(rate) << names;
+  }
+  bool mapper = false;
+  for (const auto& kv : d) mapper = mapper || kv.first.find("mapper") != std::string::npos;
+  EXPECT_TRUE(mapper) << names;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -153,6 +226,8 @@ int main(int argc, char** argv) {
             [topic](const nav_msgs::OccupancyGrid::ConstPtr& g) { g_recorder->onGrid(topic, g); })));
   }
   subs.push_back(nh.subscribe("wavog_mapping/status", 10, &Recorder::onStatus, &recorder));
+  subs.push_back(nh.subscribe("map_updates", 10, &Recorder::onUpdate, &recorder));
+  subs.push_back(nh.subscribe("/diagnostics", 10, &Recorder::onDiagnostics, &recorder));
 
   std::vector<ros::Publisher> pubs;
   for (int i = 1; i <= 4; ++i) {

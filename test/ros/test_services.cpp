@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
@@ -158,6 +159,111 @@ TEST_F(Services, ResetEmptiesTheMap) {
   const auto after = nextMap();
   ASSERT_TRUE(after);
   for (std::int8_t v : after->data) ASSERT_EQ(v, -1);
+}
+
+TEST_F(Services, PublishWindowLimitsTheGrid) {
+  // A second node on the saved map, publishing only 1 m around base_link (at (0.3, 0.2)).
+  ros::param::set("/window/resolution", 0.1);
+  ros::param::set("/window/block_levels", 6);
+  ros::param::set("/window/publish_rate", 5.0);
+  ros::param::set("/window/publish_window", 1.0);
+  ros::param::set("/window/map_file", kMapFile);
+  nav_msgs::OccupancyGrid::ConstPtr window;
+  std::mutex m;
+  ros::NodeHandle nh;
+  auto sub = nh.subscribe<nav_msgs::OccupancyGrid>(
+      "window/map", 2,
+      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
+          [&](const nav_msgs::OccupancyGrid::ConstPtr& g) {
+            std::lock_guard<std::mutex> lock(m);
+            if (g->info.width > 0) window = g;
+          }));
+  std::string output;
+  std::thread node([&] {
+    run(std::string("timeout 5 ") + WAVOG_NODE_BIN +
+            " __name:=window map:=/window/map scan:=/window/scan",
+        &output);
+  });
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(5.0);
+  while (ros::WallTime::now() < end) {
+    {
+      std::lock_guard<std::mutex> lock(m);
+      if (window) break;
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  node.join();
+  std::lock_guard<std::mutex> lock(m);
+  ASSERT_TRUE(window) << output;
+  const double w = window->info.width * window->info.resolution;
+  const double h = window->info.height * window->info.resolution;
+  EXPECT_GE(w, 2.0 - 1e-6);
+  EXPECT_LE(w, 2.2 + 1e-6);
+  EXPECT_GE(h, 2.0 - 1e-6);
+  EXPECT_LE(h, 2.2 + 1e-6);
+  EXPECT_LE(window->info.origin.position.x, 0.3 - 1.0 + 1e-6);
+  EXPECT_GE(window->info.origin.position.x, 0.3 - 1.1 - 1e-6);
+  EXPECT_LE(window->info.origin.position.y, 0.2 - 1.0 + 1e-6);
+  EXPECT_GE(window->info.origin.position.y, 0.2 - 1.1 - 1e-6);
+}
+
+TEST_F(Services, DynamicReconfigureValidatesAndApplies) {
+  dynamic_reconfigure::Reconfigure srv;
+  dynamic_reconfigure::StrParameter scales;
+  scales.name = "scales";
+  scales.value = "2,5";
+  srv.request.config.strs.push_back(scales);
+  dynamic_reconfigure::DoubleParameter gamma;
+  gamma.name = "gamma";
+  gamma.value = 0.5;
+  srv.request.config.doubles.push_back(gamma);
+  ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", srv));
+  auto value = [](const dynamic_reconfigure::Config& c, const std::string& name) {
+    for (const auto& p : c.strs) {
+      if (p.name == name) return p.value;
+    }
+    for (const auto& p : c.doubles) {
+      if (p.name == name) return std::to_string(p.value);
+    }
+    return std::string("?");
+  };
+  EXPECT_EQ(value(srv.response.config, "scales"), "2,5");
+  EXPECT_EQ(value(srv.response.config, "gamma"), std::to_string(0.5));
+
+  // map_scale_5 now exists: cells 32 x 0.1 m.
+  nav_msgs::OccupancyGrid::ConstPtr g5;
+  std::mutex m;
+  ros::NodeHandle nh;
+  auto sub = nh.subscribe<nav_msgs::OccupancyGrid>(
+      "map_scale_5", 2,
+      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
+          [&](const nav_msgs::OccupancyGrid::ConstPtr& g) {
+            std::lock_guard<std::mutex> lock(m);
+            g5 = g;
+          }));
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(5.0);
+  while (ros::WallTime::now() < end) {
+    {
+      std::lock_guard<std::mutex> lock(m);
+      if (g5) break;
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  {
+    std::lock_guard<std::mutex> lock(m);
+    ASSERT_TRUE(g5);
+    EXPECT_NEAR(g5->info.resolution, 3.2, 1e-6);
+  }
+
+  // A scale beyond block_levels (6) is refused as a whole: the previous values stay.
+  dynamic_reconfigure::Reconfigure bad;
+  scales.value = "2,9";
+  bad.request.config.strs.push_back(scales);
+  gamma.value = 0.7;
+  bad.request.config.doubles.push_back(gamma);
+  ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", bad));
+  EXPECT_EQ(value(bad.response.config, "scales"), "2,5");
+  EXPECT_EQ(value(bad.response.config, "gamma"), std::to_string(0.5));
 }
 
 TEST_F(Services, CorruptedMapFileFailsAtStartUp) {
