@@ -26,7 +26,9 @@ bool seenFree(const SimScan& scan, const LaserParams& l, const CellIndex& cell, 
   return scan.true_ranges[static_cast<std::size_t>(beam)] > std::hypot(cx, cy) + res;
 }
 
-double probability(float log_odds) { return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds))); }
+double probability(float log_odds) {
+  return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
+}
 
 // Time at which a departing object starts to move: the end of its first constant stretch.
 double departureStart(const WorldObject& o) {
@@ -86,8 +88,8 @@ std::vector<PolicyRun> standardPolicies(double resolution) {
     runs.push_back(r);
   };
   add(PolicyType::kNone, InitValue::kUnknown);
-  for (PolicyType t : {PolicyType::kMax, PolicyType::kClamp, PolicyType::kForget,
-                       PolicyType::kClampLower}) {
+  for (PolicyType t :
+       {PolicyType::kMax, PolicyType::kClamp, PolicyType::kForget, PolicyType::kClampLower}) {
     add(t, InitValue::kUnknown);
     add(t, InitValue::kEmptyBound);
   }
@@ -121,8 +123,8 @@ std::vector<WorldEvent> findEvents(const World& world, const std::vector<SimScan
     // Cells that saw the object: while parked before a departure, once parked after an arrival.
     std::map<std::pair<std::int64_t, std::int64_t>, int> hits;
     for (const SimScan& s : scans) {
-      const bool parked = e.type == WorldEvent::Type::kDeparture ? s.stamp < e.start_time
-                                                                 : s.stamp >= e.event_time;
+      const bool parked =
+          e.type == WorldEvent::Type::kDeparture ? s.stamp < e.start_time : s.stamp >= e.event_time;
       if (!parked) continue;
       const LaserParams& l = world.vehicle.lasers[static_cast<std::size_t>(s.laser)];
       for (std::size_t b = 0; b < s.hit_object.size(); ++b) {
@@ -227,8 +229,8 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
     }
     if (delays.empty()) continue;
     std::sort(delays.begin(), delays.end());
-    const auto rank = static_cast<std::size_t>(
-        std::ceil(options.fraction * static_cast<double>(delays.size())));
+    const auto rank =
+        static_cast<std::size_t>(std::ceil(options.fraction * static_cast<double>(delays.size())));
     const std::size_t q = std::min(delays.size(), std::max<std::size_t>(rank, 1)) - 1;
     result.events[k].scans = delays[q].first;
     result.events[k].seconds = delays[q].second;
@@ -273,7 +275,8 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
   const std::vector<float> to_wall =
       distanceTransform(occupancyAt(world, t_end, window, TruthFilter::kWallsOnly), window);
   std::vector<std::uint8_t> others = occupancyAt(world, t_end, window, TruthFilter::kAll);
-  const std::vector<std::uint8_t> walls = occupancyAt(world, t_end, window, TruthFilter::kWallsOnly);
+  const std::vector<std::uint8_t> walls =
+      occupancyAt(world, t_end, window, TruthFilter::kWallsOnly);
   for (std::size_t i = 0; i < others.size(); ++i) others[i] = others[i] && !walls[i];
   const std::vector<float> to_other = distanceTransform(others, window);
   double sum = 0.0;
@@ -291,8 +294,9 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
   result.bytes = stats.bytes;
   result.observed_cells = stats.observed_cells;
   result.bytes_per_observed_cell =
-      stats.observed_cells ? static_cast<double>(stats.bytes) / static_cast<double>(stats.observed_cells)
-                           : 0.0;
+      stats.observed_cells
+          ? static_cast<double>(stats.bytes) / static_cast<double>(stats.observed_cells)
+          : 0.0;
   return result;
 }
 

@@ -88,7 +88,8 @@ std::vector<std::uint8_t> rasteriseFilled(const std::vector<Polygon>& polygons,
       for (int c = 0; c < box.width; ++c) {
         const Vec2 p = box.centre(c, r);
         int col = 0, row = 0;
-        if (window.locate(p, &col, &row) && pointInPolygon(poly, p)) out[window.index(col, row)] = 1;
+        if (window.locate(p, &col, &row) && pointInPolygon(poly, p))
+          out[window.index(col, row)] = 1;
       }
     }
   }

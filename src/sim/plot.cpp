@@ -86,8 +86,8 @@ int drawText(Image* image, int x, int y, const std::string& text, Rgb colour, in
     for (int r = 0; r < 5; ++r) {
       for (int c = 0; c < 3; ++c) {
         if (g[r * 3 + c] == '#') {
-          fillRect(image, cx + c * scale, y + r * scale, cx + (c + 1) * scale,
-                   y + (r + 1) * scale, colour);
+          fillRect(image, cx + c * scale, y + r * scale, cx + (c + 1) * scale, y + (r + 1) * scale,
+                   colour);
         }
       }
     }

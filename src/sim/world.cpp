@@ -94,27 +94,35 @@ Trajectory Trajectory::fromRoute(const Points& points, double speed, double t0,
 
 const char* toString(ObjectKind kind) {
   switch (kind) {
-    case ObjectKind::kWall: return "wall";
-    case ObjectKind::kCar: return "car";
-    case ObjectKind::kPedestrian: return "pedestrian";
-    case ObjectKind::kObstacle: return "obstacle";
+    case ObjectKind::kWall:
+      return "wall";
+    case ObjectKind::kCar:
+      return "car";
+    case ObjectKind::kPedestrian:
+      return "pedestrian";
+    case ObjectKind::kObstacle:
+      return "obstacle";
   }
   return "?";
 }
 
 const char* toString(ObjectRole role) {
   switch (role) {
-    case ObjectRole::kStatic: return "static";
-    case ObjectRole::kMoving: return "moving";
-    case ObjectRole::kDeparting: return "departing";
-    case ObjectRole::kArriving: return "arriving";
+    case ObjectRole::kStatic:
+      return "static";
+    case ObjectRole::kMoving:
+      return "moving";
+    case ObjectRole::kDeparting:
+      return "departing";
+    case ObjectRole::kArriving:
+      return "arriving";
   }
   return "?";
 }
 
 bool fromString(const std::string& name, ObjectKind* kind) {
-  for (ObjectKind k : {ObjectKind::kWall, ObjectKind::kCar, ObjectKind::kPedestrian,
-                       ObjectKind::kObstacle}) {
+  for (ObjectKind k :
+       {ObjectKind::kWall, ObjectKind::kCar, ObjectKind::kPedestrian, ObjectKind::kObstacle}) {
     if (name == toString(k)) {
       *kind = k;
       return true;
@@ -124,8 +132,8 @@ bool fromString(const std::string& name, ObjectKind* kind) {
 }
 
 bool fromString(const std::string& name, ObjectRole* role) {
-  for (ObjectRole r : {ObjectRole::kStatic, ObjectRole::kMoving, ObjectRole::kDeparting,
-                       ObjectRole::kArriving}) {
+  for (ObjectRole r :
+       {ObjectRole::kStatic, ObjectRole::kMoving, ObjectRole::kDeparting, ObjectRole::kArriving}) {
     if (name == toString(r)) {
       *role = r;
       return true;

@@ -148,7 +148,8 @@ class Reader {
       for (int i = 0; i < 4; ++i) {
         if (corner == names[i]) index = i;
       }
-      if (index < 0) fail(where + ".corner", "one of front_left, front_right, rear_left, rear_right");
+      if (index < 0)
+        fail(where + ".corner", "one of front_left, front_right, rear_left, rear_right");
       if (!(length > 0 && width > 0)) fail(where + ".corner", "needs the vehicle's box");
       l = cornerLaser(index, length, width);
     }
@@ -189,8 +190,9 @@ class Reader {
       for (std::size_t i = 0; i < objs.size(); ++i) {
         const std::string where = "objects[" + std::to_string(i) + "]";
         const YAML::Node& o = objs[i];
-        checkKeys(o, where, {"name", "kind", "role", "polygon", "box", "circle", "trajectory",
-                             "route", "appear", "disappear"});
+        checkKeys(o, where,
+                  {"name", "kind", "role", "polygon", "box", "circle", "trajectory", "route",
+                   "appear", "disappear"});
         WorldObject obj;
         obj.name = text(o, "name", where, "object_" + std::to_string(i));
         if (!fromString(text(o, "kind", where, "obstacle"), &obj.kind)) {

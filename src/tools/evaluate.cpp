@@ -83,17 +83,28 @@ Options parseArgs(int argc, char** argv) {
     }
     if (i + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + a);
     const char* v = argv[++i];
-    if (a == "--world") o.world_file = v;
-    else if (a == "--out") o.out_dir = v;
-    else if (a == "--seed") o.seed = static_cast<std::uint64_t>(parseNumber(a, v));
-    else if (a == "--duration") o.duration = parseNumber(a, v);
-    else if (a == "--resolution") o.resolution = parseNumber(a, v);
-    else if (a == "--fraction") o.fraction = parseNumber(a, v);
-    else if (a == "--policy") o.policies.push_back(v);
-    else if (a == "--offline-summary") o.offline_summary = v;
-    else if (a == "--core-maps") o.core_maps = v;
-    else if (a == "--jobs") o.jobs = static_cast<int>(parseNumber(a, v));
-    else throw std::invalid_argument("unknown option: " + a);
+    if (a == "--world")
+      o.world_file = v;
+    else if (a == "--out")
+      o.out_dir = v;
+    else if (a == "--seed")
+      o.seed = static_cast<std::uint64_t>(parseNumber(a, v));
+    else if (a == "--duration")
+      o.duration = parseNumber(a, v);
+    else if (a == "--resolution")
+      o.resolution = parseNumber(a, v);
+    else if (a == "--fraction")
+      o.fraction = parseNumber(a, v);
+    else if (a == "--policy")
+      o.policies.push_back(v);
+    else if (a == "--offline-summary")
+      o.offline_summary = v;
+    else if (a == "--core-maps")
+      o.core_maps = v;
+    else if (a == "--jobs")
+      o.jobs = static_cast<int>(parseNumber(a, v));
+    else
+      throw std::invalid_argument("unknown option: " + a);
   }
   if (o.jobs < 1) throw std::invalid_argument("--jobs must be >= 1");
   if (!(o.resolution > 0.0)) throw std::invalid_argument("--resolution must be > 0");
@@ -136,9 +147,9 @@ const Rgb kBlack{0, 0, 0};
 const Rgb kWhite{255, 255, 255};
 const Rgb kGrey{150, 150, 150};
 // One colour per run, distinguishable on white.
-const Rgb kPalette[] = {{0, 0, 0},      {230, 159, 0},  {160, 110, 0},  {86, 180, 233},
-                        {0, 90, 160},   {0, 158, 115},  {0, 100, 60},   {204, 121, 167},
-                        {150, 50, 110}, {213, 94, 0},   {120, 120, 120}};
+const Rgb kPalette[] = {{0, 0, 0},      {230, 159, 0}, {160, 110, 0},  {86, 180, 233},
+                        {0, 90, 160},   {0, 158, 115}, {0, 100, 60},   {204, 121, 167},
+                        {150, 50, 110}, {213, 94, 0},  {120, 120, 120}};
 Rgb colourOf(std::size_t i) { return kPalette[i % (sizeof(kPalette) / sizeof(kPalette[0]))]; }
 
 // A raster halved in each direction: known if any child is, value the largest known child
@@ -202,7 +213,9 @@ Image plotEvent(const WorldEvent& event, std::size_t k, const std::vector<Policy
   const double t0 = std::max(0.0, event.start_time - 2.0);
   const int pw = kW - kLeft - kRight;
   const int ph = kH - kTop - kBottom;
-  auto px = [&](double t) { return kLeft + static_cast<int>(std::lround((t - t0) / (t_end - t0) * pw)); };
+  auto px = [&](double t) {
+    return kLeft + static_cast<int>(std::lround((t - t0) / (t_end - t0) * pw));
+  };
   auto py = [&](double p) { return kTop + static_cast<int>(std::lround((1.0 - p) * ph)); };
   const bool departure = event.type == WorldEvent::Type::kDeparture;
   drawText(&img, kLeft, 8,
@@ -214,7 +227,8 @@ Image plotEvent(const WorldEvent& event, std::size_t k, const std::vector<Policy
   drawLine(&img, kLeft, kTop + ph, kLeft + pw, kTop + ph, kBlack);
   drawLine(&img, kLeft, py(0.5), kLeft + pw, py(0.5), kGrey, 1, 4);
   drawLine(&img, px(event.event_time), kTop, px(event.event_time), kTop + ph, kGrey, 1, 4);
-  drawText(&img, px(event.event_time) + 4, kTop + 2, departure ? "stall clear" : "parked", kGrey, 2);
+  drawText(&img, px(event.event_time) + 4, kTop + 2, departure ? "stall clear" : "parked", kGrey,
+           2);
   for (double p = 0.0; p <= 1.0001; p += 0.25) {
     drawLine(&img, kLeft - 5, py(p), kLeft, py(p), kBlack);
     drawText(&img, 8, py(p) - 5, fixed(p, 2), kBlack, 2);
@@ -242,16 +256,17 @@ Image plotEvent(const WorldEvent& event, std::size_t k, const std::vector<Policy
 // ---- Report ------------------------------------------------------------------------------
 
 std::string report(const World& world, const Options& o, std::size_t scan_count,
-                   const std::vector<WorldEvent>& events, const std::vector<PolicyResult>& results) {
+                   const std::vector<WorldEvent>& events,
+                   const std::vector<PolicyResult>& results) {
   std::ostringstream md;
   const LaserParams& l = world.vehicle.lasers.front();
   md << "# Update policies on the simulated scenario '" << world.name << "'\n\n"
      << "Scenario: " << fixed(world.duration, 0) << " s, " << world.vehicle.lasers.size()
      << " lasers (" << l.beams << " beams over " << fixed(l.fov * 180 / M_PI, 0) << " deg, "
      << fixed(l.range_max, 0) << " m, " << fixed(l.rate_hz, 0) << " Hz each, range noise sigma "
-     << fixed(l.noise_sigma, 3) << " m, dropouts " << fixed(100 * l.dropout_prob, 1)
-     << " %), " << scan_count << " scans, seed " << o.seed << ". Map: resolution "
-     << fixed(o.resolution, 2) << " m, each policy with its documented defaults "
+     << fixed(l.noise_sigma, 3) << " m, dropouts " << fixed(100 * l.dropout_prob, 1) << " %), "
+     << scan_count << " scans, seed " << o.seed << ". Map: resolution " << fixed(o.resolution, 2)
+     << " m, each policy with its documented defaults "
      << "(`MapParams::defaultsFor`: forget odd_occ 3.5 / odd_emp -2 / gamma 0.3; the others "
      << "0.85 / -0.4, clamp [-2, 3.5]).\n\n";
   md << "Events:\n";
@@ -291,14 +306,15 @@ std::string report(const World& world, const Options& o, std::size_t scan_count,
      << " % quantile over the cells. A car's cells are those holding at least 2 true beam hits "
      << "on it while parked. *never*: not within the scenario. The plots show the mean P(occ) "
      << "of the same cells, which also waits for the truck to come back where it sees them.\n"
-     << "- *occupied precision*: share of the final map's occupied cells (log-odds > 0.001) within one "
+     << "- *occupied precision*: share of the final map's occupied cells (log-odds > 0.001) within "
+        "one "
      << "cell of a true surface at the end; *recall*: share of the observed true-surface cells "
      << "within one cell of an occupied one.\n"
      << "- *wall distance*: mean distance from occupied cells nearest to a wall (within 1 m) to "
      << "the wall's cells; about half a cell is ideal, more means thick walls.\n"
      << "- *bytes / observed cell*: `WaveletMap::stats().bytes` over the cells ever observed; "
-     << "a dense float grid costs 4. *us / scan*: `integrate()` wall time on this machine (" << o.jobs
-     << " policies run in parallel).\n\n"
+     << "a dense float grid costs 4. *us / scan*: `integrate()` wall time on this machine ("
+     << o.jobs << " policies run in parallel).\n\n"
      << "![final maps](policies.png)\n\n![departed car](departure.png)\n\n"
      << "![arrived car](arrival.png)\n";
   return md.str();
@@ -308,36 +324,39 @@ std::string json(const World& world, const Options& o, std::size_t scan_count,
                  const std::vector<WorldEvent>& events, const std::vector<PolicyResult>& results,
                  double wall_s) {
   std::ostringstream js;
-  js << "{\n  \"world\": " << jsonEscape(world.name) << ",\n  \"duration_s\": "
-     << jsonNumber(world.duration) << ",\n  \"seed\": " << o.seed << ",\n  \"scans\": "
-     << scan_count << ",\n  \"resolution\": " << jsonNumber(o.resolution)
+  js << "{\n  \"world\": " << jsonEscape(world.name)
+     << ",\n  \"duration_s\": " << jsonNumber(world.duration) << ",\n  \"seed\": " << o.seed
+     << ",\n  \"scans\": " << scan_count << ",\n  \"resolution\": " << jsonNumber(o.resolution)
      << ",\n  \"evaluation_wall_time_s\": " << jsonNumber(wall_s) << ",\n  \"events\": [";
   for (std::size_t k = 0; k < events.size(); ++k) {
     const WorldEvent& e = events[k];
     js << (k ? "," : "") << "\n    {\"name\": " << jsonEscape(e.name) << ", \"type\": "
        << (e.type == WorldEvent::Type::kDeparture ? "\"departure\"" : "\"arrival\"")
-       << ", \"start_s\": " << jsonNumber(e.start_time) << ", \"event_s\": "
-       << jsonNumber(e.event_time) << ", \"cells\": " << e.cells.size() << "}";
+       << ", \"start_s\": " << jsonNumber(e.start_time)
+       << ", \"event_s\": " << jsonNumber(e.event_time) << ", \"cells\": " << e.cells.size() << "}";
   }
   js << "\n  ],\n  \"policies\": [";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const PolicyResult& r = results[i];
-    js << (i ? "," : "") << "\n    {\"label\": " << jsonEscape(r.label) << ", \"policy\": "
-       << jsonEscape(wavog::toString(r.params.policy.type)) << ", \"init\": "
-       << jsonEscape(wavog::toString(r.params.policy.init)) << ", \"responses\": [";
+    js << (i ? "," : "") << "\n    {\"label\": " << jsonEscape(r.label)
+       << ", \"policy\": " << jsonEscape(wavog::toString(r.params.policy.type))
+       << ", \"init\": " << jsonEscape(wavog::toString(r.params.policy.init))
+       << ", \"responses\": [";
     for (std::size_t k = 0; k < r.events.size(); ++k) {
       js << (k ? ", " : "") << "{\"seconds\": " << jsonNumber(r.events[k].seconds)
          << ", \"scans\": "
          << (r.events[k].reached() ? std::to_string(r.events[k].scans) : std::string("null"))
          << "}";
     }
-    js << "], \"precision\": " << jsonNumber(r.precision) << ", \"recall\": "
-       << jsonNumber(r.recall) << ", \"wall_distance_m\": " << jsonNumber(r.wall_distance)
+    js << "], \"precision\": " << jsonNumber(r.precision)
+       << ", \"recall\": " << jsonNumber(r.recall)
+       << ", \"wall_distance_m\": " << jsonNumber(r.wall_distance)
        << ", \"occupied_cells\": " << r.occupied_cells << ", \"nodes\": " << r.nodes
        << ", \"bytes\": " << r.bytes << ", \"observed_cells\": " << r.observed_cells
        << ", \"bytes_per_observed_cell\": " << jsonNumber(r.bytes_per_observed_cell)
-       << ", \"mean_scan_us\": " << jsonNumber(r.mean_scan_us) << ", \"max_scan_us\": "
-       << jsonNumber(r.max_scan_us) << ", \"integration_s\": " << jsonNumber(r.total_s) << "}";
+       << ", \"mean_scan_us\": " << jsonNumber(r.mean_scan_us)
+       << ", \"max_scan_us\": " << jsonNumber(r.max_scan_us)
+       << ", \"integration_s\": " << jsonNumber(r.total_s) << "}";
   }
   js << "\n  ]";
   if (!o.offline_summary.empty()) {
@@ -379,14 +398,17 @@ void writeCoreMaps(const World& world, const std::vector<SimScan>& scans, const 
 }
 
 // The figures worth a glance, on stdout.
-void printHeadline(const std::vector<WorldEvent>& events, const std::vector<PolicyResult>& results) {
+void printHeadline(const std::vector<WorldEvent>& events,
+                   const std::vector<PolicyResult>& results) {
   std::cout << "\n" << std::left << std::setw(26) << "policy / init";
   for (const WorldEvent& e : events) {
     std::cout << std::setw(24)
-              << (e.type == WorldEvent::Type::kDeparture ? "departed car free" : "arrived car occ.");
+              << (e.type == WorldEvent::Type::kDeparture ? "departed car free"
+                                                         : "arrived car occ.");
   }
   std::cout << std::setw(11) << "precision" << std::setw(10) << "wall cm" << std::setw(10)
-            << "B/cell" << "us/scan\n";
+            << "B/cell"
+            << "us/scan\n";
   for (const PolicyResult& r : results) {
     std::cout << std::setw(26) << r.label;
     for (const EventResponse& e : r.events) std::cout << std::setw(24) << responseText(e);
@@ -444,8 +466,8 @@ int run(const Options& o) {
 
   const double t_end = scans.empty() ? world.duration : scans.back().stamp;
   wavog::writePng(o.out_dir + "/policies.png",
-                  sideBySide(results, "final maps at t = " + fixed(t_end, 0) + " s, " +
-                                          world.name + " (pale blue: never observed)"));
+                  sideBySide(results, "final maps at t = " + fixed(t_end, 0) + " s, " + world.name +
+                                          " (pale blue: never observed)"));
   for (std::size_t k = 0; k < events.size(); ++k) {
     const bool departure = events[k].type == WorldEvent::Type::kDeparture;
     // The first departure and the first arrival get the fixed names the report links to.

@@ -3,23 +3,22 @@
 // sensor_msgs/LaserScan topic per laser, /tf (map -> base_link at every scan time) and a latched
 // /tf_static (base_link -> each laser). Optionally writes the ground truth (the world file and
 // rasterised occupancy at chosen times). Deterministic for a seed; needs no roscore.
+#include <geometry_msgs/TransformStamped.h>
+#include <ros/time.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/LaserScan.h>
+#include <sys/stat.h>
+#include <tf2_msgs/TFMessage.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <sys/stat.h>
-
-#include <geometry_msgs/TransformStamped.h>
-#include <rosbag/bag.h>
-#include <ros/time.h>
-#include <sensor_msgs/LaserScan.h>
-#include <tf2_msgs/TFMessage.h>
 
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/sim/ground_truth.h"
@@ -39,18 +38,18 @@ using wavog::sim::World;
 constexpr double kEpoch = 1.7e9;
 
 struct Options {
-  std::string world_file;         // empty: the built-in car park
+  std::string world_file;  // empty: the built-in car park
   std::string bag = "scenario.bag";
   std::uint64_t seed = 1;
-  double duration = -1.0;         // < 0: the world's
-  double noise_sigma = -1.0;      // < 0: each laser's
-  double dropout = -1.0;          // < 0: each laser's
+  double duration = -1.0;     // < 0: the world's
+  double noise_sigma = -1.0;  // < 0: each laser's
+  double dropout = -1.0;      // < 0: each laser's
   std::string map_frame = "map";
   std::string base_frame = "base_link";
-  std::string truth_dir;          // empty: no ground truth written
+  std::string truth_dir;  // empty: no ground truth written
   double truth_resolution = 0.1;
   double truth_every = 10.0;
-  std::string write_world;        // write the world as YAML here
+  std::string write_world;  // write the world as YAML here
 };
 
 void usage(std::ostream& out) {
@@ -91,19 +90,32 @@ Options parseArgs(int argc, char** argv) {
     }
     if (i + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + a);
     const char* v = argv[++i];
-    if (a == "--world") o.world_file = v;
-    else if (a == "--out") o.bag = v;
-    else if (a == "--seed") o.seed = static_cast<std::uint64_t>(parseNumber(a, v));
-    else if (a == "--duration") o.duration = parseNumber(a, v);
-    else if (a == "--noise") o.noise_sigma = parseNumber(a, v);
-    else if (a == "--dropout") o.dropout = parseNumber(a, v);
-    else if (a == "--map-frame") o.map_frame = v;
-    else if (a == "--base-frame") o.base_frame = v;
-    else if (a == "--truth-dir") o.truth_dir = v;
-    else if (a == "--truth-resolution") o.truth_resolution = parseNumber(a, v);
-    else if (a == "--truth-every") o.truth_every = parseNumber(a, v);
-    else if (a == "--write-world") o.write_world = v;
-    else throw std::invalid_argument("unknown option: " + a);
+    if (a == "--world")
+      o.world_file = v;
+    else if (a == "--out")
+      o.bag = v;
+    else if (a == "--seed")
+      o.seed = static_cast<std::uint64_t>(parseNumber(a, v));
+    else if (a == "--duration")
+      o.duration = parseNumber(a, v);
+    else if (a == "--noise")
+      o.noise_sigma = parseNumber(a, v);
+    else if (a == "--dropout")
+      o.dropout = parseNumber(a, v);
+    else if (a == "--map-frame")
+      o.map_frame = v;
+    else if (a == "--base-frame")
+      o.base_frame = v;
+    else if (a == "--truth-dir")
+      o.truth_dir = v;
+    else if (a == "--truth-resolution")
+      o.truth_resolution = parseNumber(a, v);
+    else if (a == "--truth-every")
+      o.truth_every = parseNumber(a, v);
+    else if (a == "--write-world")
+      o.write_world = v;
+    else
+      throw std::invalid_argument("unknown option: " + a);
   }
   if (!(o.truth_resolution > 0.0)) throw std::invalid_argument("--truth-resolution must be > 0");
   if (!(o.truth_every > 0.0)) throw std::invalid_argument("--truth-every must be > 0");
@@ -171,8 +183,8 @@ void writeTruth(const World& world, const Options& o) {
 }
 
 int run(const Options& o) {
-  World world = o.world_file.empty() ? wavog::sim::defaultWorld()
-                                     : wavog::sim::loadWorld(o.world_file);
+  World world =
+      o.world_file.empty() ? wavog::sim::defaultWorld() : wavog::sim::loadWorld(o.world_file);
   if (o.duration > 0.0) world.duration = o.duration;
   for (LaserParams& l : world.vehicle.lasers) {
     if (o.noise_sigma >= 0.0) l.noise_sigma = o.noise_sigma;
@@ -215,8 +227,8 @@ int run(const Options& o) {
   // One more pose after the last scan, so a tf lookup at the last stamp never extrapolates.
   const ros::Time end = t0 + ros::Duration(world.duration);
   tf2_msgs::TFMessage tf;
-  tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame,
-                                       world.vehicle.path.at(world.duration), end));
+  tf.transforms.push_back(
+      transformMsg(o.map_frame, o.base_frame, world.vehicle.path.at(world.duration), end));
   bag.write("/tf", end, tf);
   bag.close();
 

@@ -15,8 +15,8 @@ namespace wavog {
 namespace sim {
 namespace {
 
-constexpr double kDepart = 2.0;     // s: 80 scans of the parked car at 40 Hz
-constexpr double kDuration = 6.0;   // s: 160 scans after it left
+constexpr double kDepart = 2.0;    // s: 80 scans of the parked car at 40 Hz
+constexpr double kDuration = 6.0;  // s: 160 scans after it left
 constexpr double kResolution = 0.1;
 constexpr std::uint64_t kSeed = 7;
 

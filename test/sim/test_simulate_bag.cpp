@@ -2,6 +2,10 @@
 // ranges bit for bit (so a seed fixes the bag), monotonic stamps, /tf at every scan and a latched
 // /tf_static with the mounts; and wavog_offline maps it unchanged (when it is built).
 #include <gtest/gtest.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -11,11 +15,6 @@
 #include <map>
 #include <sstream>
 #include <string>
-
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
-#include <sensor_msgs/LaserScan.h>
-#include <tf2_msgs/TFMessage.h>
 
 #include "wavog_mapping/sim/laser_sim.h"
 #include "wavog_mapping/sim/world.h"
@@ -79,7 +78,8 @@ TEST(SimulateBag, HoldsTheSimulatedScansAndTheTfTree) {
       ASSERT_TRUE(msg);
       const std::uint64_t seq = scans[m.getTopic()]++;
       const SimScan expected = sim.simulate(laser, seq);
-      EXPECT_EQ(msg->header.frame_id, world.vehicle.lasers[static_cast<std::size_t>(laser)].frame_id);
+      EXPECT_EQ(msg->header.frame_id,
+                world.vehicle.lasers[static_cast<std::size_t>(laser)].frame_id);
       EXPECT_NEAR(msg->header.stamp.toSec() - kEpoch, expected.stamp, 1e-6);
       ASSERT_EQ(msg->ranges.size(), expected.ranges.size());
       EXPECT_EQ(std::memcmp(msg->ranges.data(), expected.ranges.data(),

@@ -146,8 +146,8 @@ TEST(Trajectory, InterpolatesAndHoldsItsEnds) {
   EXPECT_NEAR(std::abs(mid.theta), M_PI, 1e-12);
   EXPECT_DOUBLE_EQ(traj.at(-5.0).x, 0.0);
   EXPECT_DOUBLE_EQ(traj.at(9.0).y, 4.0);
-  const Trajectory route = Trajectory::fromRoute({Vec2(0, 0), Vec2(10, 0), Vec2(10, 10)}, 2.0,
-                                                 1.0, 2.0);
+  const Trajectory route =
+      Trajectory::fromRoute({Vec2(0, 0), Vec2(10, 0), Vec2(10, 10)}, 2.0, 1.0, 2.0);
   EXPECT_DOUBLE_EQ(route.waypoints.front().t, 1.0);
   EXPECT_NEAR(route.at(3.0).x, 4.0, 1e-9);  // straight part at 2 m/s
   EXPECT_NEAR(route.waypoints.back().pose.theta, M_PI / 2, 1e-9);
@@ -221,7 +221,8 @@ TEST(WorldFile, ReadsJsonAndShortcuts) {
     ],
     "vehicle": {"box": [8, 2.5], "trajectory": [[0, 0, 0, 0]],
                 "lasers": [{"corner": "front_left"}, {"name": "top", "yaw_deg": 90, "beams": 181}]}
-  })", "inline json");
+  })",
+                             "inline json");
   EXPECT_EQ(w.name, "json_world");
   ASSERT_EQ(w.objects.size(), 2u);
   EXPECT_EQ(w.objects[1].kind, ObjectKind::kPedestrian);
@@ -244,8 +245,8 @@ TEST(WorldFile, ErrorsNameTheEntry) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message(base + "objects: [{kind: wall, box: [1, 1], colour: red}]").find(
-                "objects[0]: unknown key 'colour'"),
+  EXPECT_NE(message(base + "objects: [{kind: wall, box: [1, 1], colour: red}]")
+                .find("objects[0]: unknown key 'colour'"),
             std::string::npos);
   EXPECT_NE(message(base + "objects: [{kind: tree, box: [1, 1]}]").find("objects[0].kind"),
             std::string::npos);

@@ -36,10 +36,10 @@ std::vector<PolicyRun> standardPolicies(double resolution);
 struct WorldEvent {
   enum class Type { kDeparture, kArrival };
   Type type = Type::kDeparture;
-  int object = -1;           ///< index in World::objects
-  std::string name;          ///< the object's name
-  double start_time = 0.0;   ///< departure: when it starts moving; arrival: when it appears (s)
-  double event_time = 0.0;   ///< departure: when its parking footprint is clear; arrival: parked
+  int object = -1;          ///< index in World::objects
+  std::string name;         ///< the object's name
+  double start_time = 0.0;  ///< departure: when it starts moving; arrival: when it appears (s)
+  double event_time = 0.0;  ///< departure: when its parking footprint is clear; arrival: parked
   /// The cells that saw it (>= 2 true beam hits while it was parked) and that the lasers observe
   /// again after the event: free (departure) or hit (arrival).
   std::vector<CellIndex> cells;
@@ -79,17 +79,17 @@ struct PolicyResult {
   std::size_t bytes = 0;
   std::uint64_t observed_cells = 0;
   double bytes_per_observed_cell = 0.0;
-  double mean_scan_us = 0.0;   ///< integration time per scan (microseconds)
+  double mean_scan_us = 0.0;  ///< integration time per scan (microseconds)
   double max_scan_us = 0.0;
-  double total_s = 0.0;        ///< integration time of the whole scenario (s)
-  Raster final_map;            ///< the region of interest at scale 0, at the end
+  double total_s = 0.0;  ///< integration time of the whole scenario (s)
+  Raster final_map;      ///< the region of interest at scale 0, at the end
 };
 
 /// Options of an evaluation.
 struct EvaluationOptions {
-  double fraction = 0.9;        ///< quantile of the cells' delays reported per event
-  double sample_period = 0.1;   ///< period of the occupancy curves (s)
-  double wall_margin = 1.0;     ///< occupied cells count for wall_distance within this of a wall
+  double fraction = 0.9;       ///< quantile of the cells' delays reported per event
+  double sample_period = 0.1;  ///< period of the occupancy curves (s)
+  double wall_margin = 1.0;    ///< occupied cells count for wall_distance within this of a wall
 };
 
 /// Runs `scans` (from `world`) through a fresh map with `run.params` and measures it.

@@ -3,9 +3,8 @@
 #ifndef WAVOG_MAPPING_SIM_GEOMETRY_H_
 #define WAVOG_MAPPING_SIM_GEOMETRY_H_
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "wavog_mapping/core/types.h"
 

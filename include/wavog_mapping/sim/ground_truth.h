@@ -28,9 +28,7 @@ struct GridWindow {
   Vec2 centre(int col, int row) const;
   /// Window position of a world point; false if outside.
   bool locate(const Vec2& p, int* col, int* row) const;
-  std::size_t index(int col, int row) const {
-    return static_cast<std::size_t>(row) * width + col;
-  }
+  std::size_t index(int col, int row) const { return static_cast<std::size_t>(row) * width + col; }
 };
 
 /// 1 where the cell centre lies inside one of `polygons`, else 0.

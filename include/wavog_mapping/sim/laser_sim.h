@@ -52,12 +52,12 @@ class SimRandom {
 
 /// One simulated scan of one laser, with its ground truth.
 struct SimScan {
-  double stamp = 0.0;          ///< time since the start of the scenario (s)
-  int laser = 0;               ///< index in World::vehicle.lasers
-  std::uint64_t seq = 0;       ///< scan number of that laser, from 0
-  Pose2 vehicle_pose;          ///< base_link in the world frame
-  Pose2 sensor_pose;           ///< the laser in the world frame
-  std::vector<float> ranges;   ///< measured: noisy, NaN dropouts, +inf no return (m)
+  double stamp = 0.0;               ///< time since the start of the scenario (s)
+  int laser = 0;                    ///< index in World::vehicle.lasers
+  std::uint64_t seq = 0;            ///< scan number of that laser, from 0
+  Pose2 vehicle_pose;               ///< base_link in the world frame
+  Pose2 sensor_pose;                ///< the laser in the world frame
+  std::vector<float> ranges;        ///< measured: noisy, NaN dropouts, +inf no return (m)
   std::vector<double> true_ranges;  ///< exact distance to the first surface, +inf if none (m)
   std::vector<int> hit_object;      ///< per beam: index in World::objects hit, -1 if none
   /// A view for WaveletMap::integrate, valid while this scan lives and is unchanged.

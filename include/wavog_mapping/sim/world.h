@@ -63,34 +63,34 @@ struct WorldObject {
 
 /// A simulated planar laser (defaults: SICK LMS-291, 180 deg at 0.5 deg, 80 m, 40 Hz).
 struct LaserParams {
-  std::string name = "laser";       ///< short name, e.g. "front_left"
-  std::string frame_id = "laser";   ///< tf frame of the scans (no leading slash)
-  std::string topic = "scan";       ///< bag topic of the scans
-  Pose2 mount;                      ///< pose in the vehicle (base_link) frame
-  int beams = 361;                  ///< number of beams, >= 2
-  double fov = M_PI;                ///< angular span from first to last beam (rad)
-  double range_min = 0.0;           ///< readings below are invalid (m)
-  double range_max = 80.0;          ///< no return at or beyond (m)
-  double rate_hz = 40.0;            ///< scans per second
-  double phase_s = 0.0;             ///< time of the first scan (s), staggers the lasers
-  double noise_sigma = 0.02;        ///< standard deviation of the Gaussian range noise (m)
-  double dropout_prob = 0.002;      ///< probability of a NaN reading per beam
+  std::string name = "laser";      ///< short name, e.g. "front_left"
+  std::string frame_id = "laser";  ///< tf frame of the scans (no leading slash)
+  std::string topic = "scan";      ///< bag topic of the scans
+  Pose2 mount;                     ///< pose in the vehicle (base_link) frame
+  int beams = 361;                 ///< number of beams, >= 2
+  double fov = M_PI;               ///< angular span from first to last beam (rad)
+  double range_min = 0.0;          ///< readings below are invalid (m)
+  double range_max = 80.0;         ///< no return at or beyond (m)
+  double rate_hz = 40.0;           ///< scans per second
+  double phase_s = 0.0;            ///< time of the first scan (s), staggers the lasers
+  double noise_sigma = 0.02;       ///< standard deviation of the Gaussian range noise (m)
+  double dropout_prob = 0.002;     ///< probability of a NaN reading per beam
   double angleMin() const { return -fov / 2; }
   double angleIncrement() const { return fov / (beams - 1); }
 };
 
 /// The ego vehicle: a path and its lasers. Its own body is not seen by its lasers.
 struct Vehicle {
-  Polygon footprint;               ///< in base_link, for drawing only
-  Trajectory path;                 ///< pose of base_link in the world frame
+  Polygon footprint;  ///< in base_link, for drawing only
+  Trajectory path;    ///< pose of base_link in the world frame
   std::vector<LaserParams> lasers;
 };
 
 /// A scenario: objects, the vehicle, a duration and a region of interest for maps and metrics.
 struct World {
   std::string name = "world";
-  double duration = 60.0;   ///< scans are produced for t in [0, duration) (s)
-  Vec2 region_min = Vec2(0, 0);    ///< region of interest, for ground truth and pictures (m)
+  double duration = 60.0;        ///< scans are produced for t in [0, duration) (s)
+  Vec2 region_min = Vec2(0, 0);  ///< region of interest, for ground truth and pictures (m)
   Vec2 region_max = Vec2(10, 10);
   std::vector<WorldObject> objects;
   Vehicle vehicle;
@@ -102,8 +102,8 @@ struct World {
   std::vector<std::string> validate() const;
 };
 
-/// Pose of a LMS-291 mounted at a corner of a `length` x `width` vehicle, facing outwards at 45 deg.
-/// corner: 0 front-left, 1 front-right, 2 rear-left, 3 rear-right.
+/// Pose of a LMS-291 mounted at a corner of a `length` x `width` vehicle, facing outwards at 45
+/// deg. corner: 0 front-left, 1 front-right, 2 rear-left, 3 rear-right.
 LaserParams cornerLaser(int corner, double length, double width);
 
 /// The built-in default scenario: a car park (walls, rows of parked cars, one car leaving, one

@@ -1,14 +1,19 @@
-// World files: a scenario as YAML or JSON (JSON is read as YAML flow style). Layout:
-//   name: car_park            duration: 60          region: [xmin, ymin, xmax, ymax]
-//   objects:                  # kind: wall|car|pedestrian|obstacle, role: static|moving|departing|arriving
-//     - {name: w, kind: wall, polygon: [[x, y], ...]}                       # world frame
-//     - {name: c, kind: car, role: departing, box: [length, width],         # or polygon (object frame)
-//        trajectory: [[t, x, y, theta_deg], ...], appear: t0, disappear: t1}
-//     - {name: p, kind: pedestrian, circle: [radius, sides], route: {speed: 1, start: 2, points: [[x, y], ...]}}
+// World files: a scenario as YAML or JSON (JSON is read as YAML flow style). Angles in degrees.
+//   name: car_park
+//   duration: 60                      # s
+//   region: [xmin, ymin, xmax, ymax]  # ground truth and pictures (m)
+//   objects:                          # kind: wall | car | pedestrian | obstacle
+//                                     # role: static | moving | departing | arriving
+//     - {name: w, kind: wall, polygon: [[x, y], ...]}      # no trajectory: world frame
+//     - {name: c, kind: car, role: departing, box: [length, width],   # or polygon, circle
+//        trajectory: [[t, x, y, yaw_deg], ...], appear: t0, disappear: t1}
+//     - {name: p, kind: pedestrian, circle: [radius, sides],
+//        route: {speed: 1, start: 2, corner_radius: 0, points: [[x, y], ...]}}
 //   vehicle: {box: [8, 2.5], trajectory: [...] or route: {...}, lasers: [...]}
-//   lasers: {name, frame_id, topic, x, y, yaw_deg, beams, fov_deg, range_min, range_max, rate_hz,
-//            phase_s, noise_sigma, dropout_prob}; or {corner: front_left, ...} for an LMS-291 at a
-//            corner of the vehicle box. Angles in files are in degrees.
+// A laser: {name, frame_id, topic, x, y, yaw_deg, beams, fov_deg, range_min, range_max, rate_hz,
+// phase_s, noise_sigma, dropout_prob}, every key optional (LMS-291 defaults), or
+// {corner: front_left | front_right | rear_left | rear_right, ...} for one at a corner of the
+// vehicle's box facing outwards at 45 deg.
 #ifndef WAVOG_MAPPING_SIM_WORLD_FILE_H_
 #define WAVOG_MAPPING_SIM_WORLD_FILE_H_
 
