@@ -20,7 +20,7 @@ namespace wavog {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr long kMaxBeams = 100000;          // sanity bound on a beam count field
+constexpr long kMaxBeams = 100000;             // sanity bound on a beam count field
 constexpr unsigned kGzBufferBytes = 1u << 18;  // zlib's input/output buffers
 constexpr std::size_t kLineChunk = 1u << 16;   // gzgets chunk; longer lines are assembled
 
@@ -219,7 +219,8 @@ struct CarmenReader::Impl {
     const char* message = gzerror(file, &errnum);
     if (errnum == Z_OK) return;
     if (errnum == Z_BUF_ERROR) {
-      throw std::runtime_error(path + ": truncated gzip stream (unexpected end of file after line " +
+      throw std::runtime_error(path +
+                               ": truncated gzip stream (unexpected end of file after line " +
                                std::to_string(line_number) + ")");
     }
     if (errnum == Z_ERRNO) {

@@ -56,7 +56,8 @@ std::string readFile(const std::string& path) {
 }
 
 void putBe32(std::string* out, std::uint32_t v) {
-  for (int shift = 24; shift >= 0; shift -= 8) out->push_back(static_cast<char>((v >> shift) & 0xffu));
+  for (int shift = 24; shift >= 0; shift -= 8)
+    out->push_back(static_cast<char>((v >> shift) & 0xffu));
 }
 
 std::uint32_t getBe32(const std::string& s, std::size_t pos) {
@@ -70,8 +71,8 @@ void putChunk(std::string* out, const char type[4], const std::string& data) {
   std::string body(type, 4);
   body += data;
   out->append(body);
-  const auto crc = crc32(0L, reinterpret_cast<const Bytef*>(body.data()),
-                         static_cast<uInt>(body.size()));
+  const auto crc =
+      crc32(0L, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()));
   putBe32(out, static_cast<std::uint32_t>(crc));
 }
 
@@ -171,8 +172,8 @@ Image renderGrey(const Raster& raster, const RenderOptions& options) {
 
 void writePng(const std::string& path, const Image& image) {
   checkImage(path, image);
-  const std::size_t stride = static_cast<std::size_t>(image.width) *
-                             static_cast<std::size_t>(image.channels);
+  const std::size_t stride =
+      static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.channels);
   // Two encodings, the smaller one kept: no filter, and per row the filter type with the smallest
   // sum of |signed residuals| (the PNG spec's heuristic), which wins on smooth pictures but can
   // lose on graded maps with sharp edges.
@@ -198,11 +199,20 @@ void writePng(const std::string& path, const Image& image) {
         const int c = (up && i >= bpp) ? up[i - bpp] : 0;
         int predicted = 0;
         switch (f) {
-          case 1: predicted = a; break;
-          case 2: predicted = b; break;
-          case 3: predicted = (a + b) / 2; break;
-          case 4: predicted = paeth(a, b, c); break;
-          default: break;
+          case 1:
+            predicted = a;
+            break;
+          case 2:
+            predicted = b;
+            break;
+          case 3:
+            predicted = (a + b) / 2;
+            break;
+          case 4:
+            predicted = paeth(a, b, c);
+            break;
+          default:
+            break;
         }
         const auto residual = static_cast<std::uint8_t>((row[i] - predicted) & 0xff);
         candidates[f][i] = residual;
@@ -239,8 +249,8 @@ void writePng(const std::string& path, const Image& image) {
 void writePgm(const std::string& path, const Image& image) {
   checkImage(path, image);
   if (image.channels != 1) throw std::runtime_error(path + ": a PGM needs a grey image");
-  std::string out = "P5\n" + std::to_string(image.width) + " " + std::to_string(image.height) +
-                    "\n255\n";
+  std::string out =
+      "P5\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n";
   out.append(reinterpret_cast<const char*>(image.pixels.data()), image.pixels.size());
   writeFile(path, out);
 }
@@ -250,8 +260,9 @@ Image readPng(const std::string& path) {
   auto fail = [&path](const std::string& why) -> std::runtime_error {
     return std::runtime_error(path + ": not a readable PNG: " + why);
   };
-  if (file.size() < 8 || !std::equal(kPngSignature.begin(), kPngSignature.end(), file.begin(),
-                                     [](std::uint8_t a, char b) { return a == static_cast<std::uint8_t>(b); })) {
+  if (file.size() < 8 ||
+      !std::equal(kPngSignature.begin(), kPngSignature.end(), file.begin(),
+                  [](std::uint8_t a, char b) { return a == static_cast<std::uint8_t>(b); })) {
     throw fail("bad signature");
   }
   Image image;
@@ -299,8 +310,8 @@ Image readPng(const std::string& path) {
   std::string raw((stride + 1) * height, '\0');
   uLongf raw_size = static_cast<uLongf>(raw.size());
   if (uncompress(reinterpret_cast<Bytef*>(&raw[0]), &raw_size,
-                 reinterpret_cast<const Bytef*>(idat.data()), static_cast<uLong>(idat.size())) !=
-          Z_OK ||
+                 reinterpret_cast<const Bytef*>(idat.data()),
+                 static_cast<uLong>(idat.size())) != Z_OK ||
       raw_size != raw.size()) {
     throw fail("damaged image data");
   }
@@ -317,12 +328,23 @@ Image readPng(const std::string& path) {
       const int c = (up && i >= bpp) ? up[i - bpp] : 0;
       int predicted = 0;
       switch (filter) {
-        case 0: predicted = 0; break;
-        case 1: predicted = a; break;
-        case 2: predicted = b; break;
-        case 3: predicted = (a + b) / 2; break;
-        case 4: predicted = paeth(a, b, c); break;
-        default: throw fail("bad filter type " + std::to_string(filter));
+        case 0:
+          predicted = 0;
+          break;
+        case 1:
+          predicted = a;
+          break;
+        case 2:
+          predicted = b;
+          break;
+        case 3:
+          predicted = (a + b) / 2;
+          break;
+        case 4:
+          predicted = paeth(a, b, c);
+          break;
+        default:
+          throw fail("bad filter type " + std::to_string(filter));
       }
       out[i] = static_cast<std::uint8_t>((in[i] + predicted) & 0xff);
     }

@@ -2,7 +2,12 @@
 // sensor_msgs/LaserScan per laser (REP 117: no return as +inf), /tf (map -> base_link from the
 // corrected poses, or odom -> base_link from the odometry) and a latched /tf_static
 // (base_link -> laser), all with strictly increasing stamps. Written with the rosbag C++ API.
+#include <geometry_msgs/TransformStamped.h>
 #include <getopt.h>
+#include <ros/time.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <cmath>
 #include <cstdio>
@@ -12,12 +17,6 @@
 #include <limits>
 #include <map>
 #include <string>
-
-#include <geometry_msgs/TransformStamped.h>
-#include <ros/time.h>
-#include <rosbag/bag.h>
-#include <sensor_msgs/LaserScan.h>
-#include <tf2_msgs/TFMessage.h>
 
 #include "tool_support.h"
 #include "wavog_mapping/io/carmen_reader.h"
@@ -44,29 +43,41 @@ struct Options {
 };
 
 void usage(std::FILE* out) {
-  std::fprintf(out,
-               "Usage: wavog_log2bag [options] LOG OUTPUT.bag\n"
-               "Converts a CARMEN log (FLASER, RLASER, ROBOTLASER1; plain or .gz) into a rosbag:\n"
-               "/front_laser/scan, /rear_laser/scan (sensor_msgs/LaserScan), /tf, /tf_static.\n\n"
-               "  --max-scans N       convert the first N scans only (0: all; default 0)\n"
-               "  --strict            a malformed line is fatal (default: report file:line, skip)\n"
-               "  --odom              /tf odom -> base_link from the raw odometry (default:\n"
-               "                      map -> base_link from the corrected poses)\n"
-               "  --stamp ipc|logger  which time stamp of the log to use (default ipc)\n"
-               "  --rate HZ           rate used to synthesise missing (zero) stamps (default 10)\n"
-               "  --epoch S           relative stamps are shifted to start here (default 1.6e9)\n"
-               "  --range-min M       range_min of the scans (default 0)\n"
-               "  --compression none|bz2|lz4  bag chunk compression (default none)\n"
-               "  --pad S             S seconds of bag time before the first scan (only /tf_static)\n"
-               "                      and after the last (the last pose held on /tf), so that\n"
-               "                      `rosbag play` subscribers connect in time, the last scan's tf\n"
-               "                      is complete, and nodes can be queried before play exits\n"
-               "  --quiet             only errors\n"
-               "  -h, --help\n");
+  std::fprintf(
+      out,
+      "Usage: wavog_log2bag [options] LOG OUTPUT.bag\n"
+      "Converts a CARMEN log (FLASER, RLASER, ROBOTLASER1; plain or .gz) into a rosbag:\n"
+      "/front_laser/scan, /rear_laser/scan (sensor_msgs/LaserScan), /tf, /tf_static.\n\n"
+      "  --max-scans N       convert the first N scans only (0: all; default 0)\n"
+      "  --strict            a malformed line is fatal (default: report file:line, skip)\n"
+      "  --odom              /tf odom -> base_link from the raw odometry (default:\n"
+      "                      map -> base_link from the corrected poses)\n"
+      "  --stamp ipc|logger  which time stamp of the log to use (default ipc)\n"
+      "  --rate HZ           rate used to synthesise missing (zero) stamps (default 10)\n"
+      "  --epoch S           relative stamps are shifted to start here (default 1.6e9)\n"
+      "  --range-min M       range_min of the scans (default 0)\n"
+      "  --compression none|bz2|lz4  bag chunk compression (default none)\n"
+      "  --pad S             S seconds of bag time before the first scan (only /tf_static)\n"
+      "                      and after the last (the last pose held on /tf), so that\n"
+      "                      `rosbag play` subscribers connect in time, the last scan's tf\n"
+      "                      is complete, and nodes can be queried before play exits\n"
+      "  --quiet             only errors\n"
+      "  -h, --help\n");
 }
 
 bool parseOptions(int argc, char** argv, Options* o) {
-  enum { kMax = 1000, kStrict, kOdom, kStamp, kRate, kEpoch, kRangeMin, kCompression, kPad, kQuiet };
+  enum {
+    kMax = 1000,
+    kStrict,
+    kOdom,
+    kStamp,
+    kRate,
+    kEpoch,
+    kRangeMin,
+    kCompression,
+    kPad,
+    kQuiet
+  };
   const option longopts[] = {{"max-scans", required_argument, nullptr, kMax},
                              {"strict", no_argument, nullptr, kStrict},
                              {"odom", no_argument, nullptr, kOdom},
@@ -82,30 +93,54 @@ bool parseOptions(int argc, char** argv, Options* o) {
   int c = 0;
   while ((c = getopt_long(argc, argv, "h", longopts, nullptr)) != -1) {
     switch (c) {
-      case kMax: o->max_scans = std::stoul(optarg); break;
-      case kStrict: o->strict = true; break;
-      case kOdom: o->odom = true; break;
+      case kMax:
+        o->max_scans = std::stoul(optarg);
+        break;
+      case kStrict:
+        o->strict = true;
+        break;
+      case kOdom:
+        o->odom = true;
+        break;
       case kStamp:
         if (std::string(optarg) != "ipc" && std::string(optarg) != "logger") {
-          throw std::invalid_argument("--stamp must be ipc or logger, not '" + std::string(optarg) + "'");
+          throw std::invalid_argument("--stamp must be ipc or logger, not '" + std::string(optarg) +
+                                      "'");
         }
         o->logger_stamp = std::string(optarg) == "logger";
         break;
-      case kRate: o->rate = std::stod(optarg); break;
-      case kEpoch: o->epoch = std::stod(optarg); break;
-      case kRangeMin: o->range_min = std::stod(optarg); break;
-      case kCompression: o->compression = optarg; break;
-      case kPad: o->pad = std::stod(optarg); break;
-      case kQuiet: o->quiet = true; break;
-      case 'h': usage(stdout); std::exit(0);
-      default: return false;
+      case kRate:
+        o->rate = std::stod(optarg);
+        break;
+      case kEpoch:
+        o->epoch = std::stod(optarg);
+        break;
+      case kRangeMin:
+        o->range_min = std::stod(optarg);
+        break;
+      case kCompression:
+        o->compression = optarg;
+        break;
+      case kPad:
+        o->pad = std::stod(optarg);
+        break;
+      case kQuiet:
+        o->quiet = true;
+        break;
+      case 'h':
+        usage(stdout);
+        std::exit(0);
+      default:
+        return false;
     }
   }
   if (argc - optind != 2) return false;
   o->log = argv[optind];
   o->bag = argv[optind + 1];
-  if (!(o->rate > 0.0) || !std::isfinite(o->rate)) throw std::invalid_argument("--rate must be > 0");
-  if (!(o->pad >= 0.0) || o->pad > 3600.0) throw std::invalid_argument("--pad must be in [0, 3600]");
+  if (!(o->rate > 0.0) || !std::isfinite(o->rate))
+    throw std::invalid_argument("--rate must be > 0");
+  if (!(o->pad >= 0.0) || o->pad > 3600.0)
+    throw std::invalid_argument("--pad must be in [0, 3600]");
   if (!(o->range_min >= 0.0)) throw std::invalid_argument("--range-min must be >= 0");
   if (o->compression != "none" && o->compression != "bz2" && o->compression != "lz4") {
     throw std::invalid_argument("--compression must be none, bz2 or lz4");
@@ -134,8 +169,8 @@ sensor_msgs::LaserScan toLaserScan(const wavog::CarmenScan& scan, const std::str
   msg.header.frame_id = frame;
   msg.angle_min = static_cast<float>(scan.angle_min);
   msg.angle_increment = static_cast<float>(scan.angle_increment);
-  msg.angle_max = static_cast<float>(scan.angle_min + scan.angle_increment *
-                                                          static_cast<double>(scan.ranges.size() - 1));
+  msg.angle_max = static_cast<float>(
+      scan.angle_min + scan.angle_increment * static_cast<double>(scan.ranges.size() - 1));
   msg.time_increment = 0.0f;  // CARMEN logs do not time the beams: one pose per scan
   msg.scan_time = 0.0f;
   msg.range_min = static_cast<float>(range_min);
@@ -207,9 +242,9 @@ int run(const Options& o) {
       last_stamp = stamp;
       // base_link pose such that base_link * mount is exactly the logged laser pose (corrected),
       // or the robot's odometry pose with --odom.
-      const wavog::Pose2 base = o.odom ? scan.robot_pose
-                                       : wavog_tools::compose(scan.laser_pose,
-                                                              wavog_tools::inverse(laser->mount));
+      const wavog::Pose2 base =
+          o.odom ? scan.robot_pose
+                 : wavog_tools::compose(scan.laser_pose, wavog_tools::inverse(laser->mount));
       last_base = base;
       tf2_msgs::TFMessage tf;
       tf.transforms.push_back(toTransform(fixed_frame, base_frame, base, stamp));
@@ -249,8 +284,8 @@ int run(const Options& o) {
   if (!o.quiet) {
     std::cerr << "wavog_log2bag: wrote " << o.bag << ": " << written << " scans";
     for (const auto& [topic, n] : per_topic) std::cerr << ", " << n << " on " << topic;
-    std::cerr << ", " << tf_messages << " on /tf (" << fixed_frame << " -> " << base_frame
-              << "), " << (o.pad > 0.0 ? 2 : 1) << " on /tf_static\n";
+    std::cerr << ", " << tf_messages << " on /tf (" << fixed_frame << " -> " << base_frame << "), "
+              << (o.pad > 0.0 ? 2 : 1) << " on /tf_static\n";
     for (const auto& l : plan.lasers) {
       if (l.used && !l.mount_from_log) {
         std::cerr << "wavog_log2bag: " << l.type << ": the log's robot pose is not in the laser "

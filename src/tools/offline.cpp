@@ -6,6 +6,12 @@
 // through the one loader (wavog_ros::configFromXmlRpc). Writes per scale a PNG, a map_server PGM +
 // YAML, the native map, summary.json and optional snapshots.
 #include <getopt.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2/buffer_core.h>
+#include <tf2/exceptions.h>
+#include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -25,13 +31,6 @@
 #include <string>
 #include <vector>
 
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
-#include <sensor_msgs/LaserScan.h>
-#include <tf2/buffer_core.h>
-#include <tf2/exceptions.h>
-#include <tf2_msgs/TFMessage.h>
-
 #include "tool_support.h"
 #include "wavog_mapping/core/motion_compensation.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -45,8 +44,8 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-constexpr int kCropMargin = 2;            // unknown cells kept around the known part of a picture
-constexpr double kTfCacheMargin = 60.0;   // s added to the bag's duration for the tf buffer
+constexpr int kCropMargin = 2;           // unknown cells kept around the known part of a picture
+constexpr double kTfCacheMargin = 60.0;  // s added to the bag's duration for the tf buffer
 
 struct Options {
   std::string input;
@@ -83,7 +82,8 @@ void usage(std::FILE* out) {
       "                          every sensor_msgs/LaserScan topic of the bag)\n"
       "  --fixed-frame F         map frame (default: the YAML's map_frame); give the scan's own\n"
       "                          frame to map a bag without tf with the laser held fixed\n"
-      "  --snapshot-every S      also write snapshots/t<seconds>_s<scale>.png every S s of log time\n"
+      "  --snapshot-every S      also write snapshots/t<seconds>_s<scale>.png every S s of log "
+      "time\n"
       "  --no-progress           no progress bar\n"
       "  --quiet                 only errors\n"
       "  -h, --help\n");
@@ -97,8 +97,18 @@ std::vector<int> parseScales(const std::string& text) {
 }
 
 bool parseOptions(int argc, char** argv, Options* o) {
-  enum { kPolicy = 1000, kResolution, kScale, kAggregation, kMax, kTopics, kFixed, kSnapshot,
-         kNoProgress, kQuiet };
+  enum {
+    kPolicy = 1000,
+    kResolution,
+    kScale,
+    kAggregation,
+    kMax,
+    kTopics,
+    kFixed,
+    kSnapshot,
+    kNoProgress,
+    kQuiet
+  };
   const option longopts[] = {{"out", required_argument, nullptr, 'o'},
                              {"config", required_argument, nullptr, 'c'},
                              {"policy", required_argument, nullptr, kPolicy},
@@ -116,20 +126,48 @@ bool parseOptions(int argc, char** argv, Options* o) {
   int c = 0;
   while ((c = getopt_long(argc, argv, "o:c:h", longopts, nullptr)) != -1) {
     switch (c) {
-      case 'o': o->out = optarg; break;
-      case 'c': o->config = optarg; break;
-      case kPolicy: o->policy = optarg; break;
-      case kResolution: o->resolution = std::stod(optarg); break;
-      case kScale: o->scales = parseScales(optarg); break;
-      case kAggregation: o->aggregation = optarg; break;
-      case kMax: o->max_scans = std::stoul(optarg); break;
-      case kTopics: o->topics = wavog_tools::splitList(optarg); break;
-      case kFixed: o->fixed_frame = wavog_tools::stripSlash(optarg); break;
-      case kSnapshot: o->snapshot_every = std::stod(optarg); break;
-      case kNoProgress: o->progress = false; break;
-      case kQuiet: o->quiet = true; o->progress = false; break;
-      case 'h': usage(stdout); std::exit(0);
-      default: return false;
+      case 'o':
+        o->out = optarg;
+        break;
+      case 'c':
+        o->config = optarg;
+        break;
+      case kPolicy:
+        o->policy = optarg;
+        break;
+      case kResolution:
+        o->resolution = std::stod(optarg);
+        break;
+      case kScale:
+        o->scales = parseScales(optarg);
+        break;
+      case kAggregation:
+        o->aggregation = optarg;
+        break;
+      case kMax:
+        o->max_scans = std::stoul(optarg);
+        break;
+      case kTopics:
+        o->topics = wavog_tools::splitList(optarg);
+        break;
+      case kFixed:
+        o->fixed_frame = wavog_tools::stripSlash(optarg);
+        break;
+      case kSnapshot:
+        o->snapshot_every = std::stod(optarg);
+        break;
+      case kNoProgress:
+        o->progress = false;
+        break;
+      case kQuiet:
+        o->quiet = true;
+        o->progress = false;
+        break;
+      case 'h':
+        usage(stdout);
+        std::exit(0);
+      default:
+        return false;
     }
   }
   if (argc - optind != 1) return false;
@@ -204,9 +242,7 @@ class Session {
     progress_.update(done_);
   }
 
-  void drop(const std::string& reason) {
-    ++dropped_[reason];
-  }
+  void drop(const std::string& reason) { ++dropped_[reason]; }
   /// A scan that was considered but not integrated (progress advances).
   void skip(const std::string& reason) {
     drop(reason);
@@ -242,8 +278,8 @@ class Session {
   void maybeSnapshot(double stamp) {
     if (o_.snapshot_every <= 0.0) return;
     if (stamp - first_stamp_ < next_snapshot_) return;
-    next_snapshot_ = (std::floor((stamp - first_stamp_) / o_.snapshot_every) + 1.0) *
-                     o_.snapshot_every;
+    next_snapshot_ =
+        (std::floor((stamp - first_stamp_) / o_.snapshot_every) + 1.0) * o_.snapshot_every;
     const int scale = snapshotScale();
     wavog::CellBox box;
     if (!map_.bounds(scale, &box)) return;
@@ -283,8 +319,9 @@ struct InputInfo {
   std::string fixed_frame;
   std::string read_error;
   std::vector<std::string> warnings;
-  std::size_t motion_compensated = 0;  // scans re-binned over their sweep (bags with time_increment)
-  std::size_t motion_fallbacks = 0;    // no tf at the sweep's end: integrated uncompensated
+  std::size_t motion_compensated =
+      0;                             // scans re-binned over their sweep (bags with time_increment)
+  std::size_t motion_fallbacks = 0;  // no tf at the sweep's end: integrated uncompensated
 };
 
 std::string describeBagTopics(const rosbag::Bag& bag) {
@@ -310,8 +347,8 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
                  std::unique_ptr<Session>* session) {
   InputInfo info;
   info.type = "bag";
-  info.fixed_frame = o.fixed_frame.empty() ? wavog_tools::stripSlash(config.ros.map_frame)
-                                           : o.fixed_frame;
+  info.fixed_frame =
+      o.fixed_frame.empty() ? wavog_tools::stripSlash(config.ros.map_frame) : o.fixed_frame;
   rosbag::Bag bag;
   try {
     bag.open(o.input, rosbag::bagmode::Read);
@@ -346,19 +383,18 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
     for (const auto& t : wanted) {
       const auto it = bag_topics.find(normaliseTopic(t));
       if (it == bag_topics.end()) {
-        throw std::runtime_error(o.input + ": the bag has no topic '" + t + "' (use --topics); it has:" +
-                                 describeBagTopics(bag));
+        throw std::runtime_error(o.input + ": the bag has no topic '" + t +
+                                 "' (use --topics); it has:" + describeBagTopics(bag));
       }
       info.topics.push_back(it->second);
     }
   }
 
   // tf: the whole bag into one buffer first, so each scan sees tf before and after its stamp.
-  rosbag::View tf_view(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf", "/tf_static", "tf",
-                                                                         "tf_static"}));
-  const double duration = (tf_view.size() > 0)
-                              ? (tf_view.getEndTime() - tf_view.getBeginTime()).toSec()
-                              : 0.0;
+  rosbag::View tf_view(
+      bag, rosbag::TopicQuery(std::vector<std::string>{"/tf", "/tf_static", "tf", "tf_static"}));
+  const double duration =
+      (tf_view.size() > 0) ? (tf_view.getEndTime() - tf_view.getBeginTime()).toSec() : 0.0;
   tf2::BufferCore tf(ros::Duration(duration + kTfCacheMargin));
   for (const rosbag::MessageInstance& m : tf_view) {
     const auto msg = m.instantiate<tf2_msgs::TFMessage>();
@@ -449,7 +485,8 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
         << ").\n  Frames in the bag's tf: ";
     if (frames.empty()) msg << "none (the bag has no /tf or /tf_static)";
     for (std::size_t i = 0; i < frames.size(); ++i) msg << (i ? ", " : "") << frames[i];
-    msg << ".\n  Use --fixed-frame <frame> (e.g. the scan frame, to map with the laser held fixed).";
+    msg << ".\n  Use --fixed-frame <frame> (e.g. the scan frame, to map with the laser held "
+           "fixed).";
     throw std::runtime_error(msg.str());
   }
   return info;
@@ -465,8 +502,9 @@ InputInfo runCarmen(const Options& o, const wavog_ros::Config& config,
     if (l.used) info.topics.push_back(l.type);
   }
   if (plan.skipped_duplicates > 0) {
-    info.warnings.push_back(std::to_string(plan.skipped_duplicates) +
-                            " ROBOTLASER1 scans skipped: the log's FLASER lines hold the same laser");
+    info.warnings.push_back(
+        std::to_string(plan.skipped_duplicates) +
+        " ROBOTLASER1 scans skipped: the log's FLASER lines hold the same laser");
   }
   std::size_t total = plan.scans_used;
   if (o.max_scans > 0) total = std::min(total, o.max_scans);
@@ -550,14 +588,16 @@ int run(const Options& o) {
   }
   for (int s : o.scales) {
     if (s < 0 || s > config.map.grid.block_levels) {
-      throw std::invalid_argument("--scale " + std::to_string(s) + " is outside [0, block_levels = " +
-                                  std::to_string(config.map.grid.block_levels) + "]");
+      throw std::invalid_argument(
+          "--scale " + std::to_string(s) +
+          " is outside [0, block_levels = " + std::to_string(config.map.grid.block_levels) + "]");
     }
   }
   fs::create_directories(o.out);
 
   std::unique_ptr<Session> session;
-  const InputInfo info = isBag(o.input) ? runBag(o, config, &session) : runCarmen(o, config, &session);
+  const InputInfo info =
+      isBag(o.input) ? runBag(o, config, &session) : runCarmen(o, config, &session);
   Session& s = *session;
   const double loop_s = std::chrono::duration<double>(Clock::now() - start).count();
   if (!o.quiet) {
@@ -590,8 +630,8 @@ int run(const Options& o) {
   const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
 
   std::ostringstream json;
-  json << "{\n  \"input\": " << wavog_tools::jsonString(o.input)
-       << ",\n  \"input_type\": \"" << info.type << "\""
+  json << "{\n  \"input\": " << wavog_tools::jsonString(o.input) << ",\n  \"input_type\": \""
+       << info.type << "\""
        << ",\n  \"config\": " << (o.config.empty() ? "null" : wavog_tools::jsonString(o.config))
        << ",\n  \"policy\": \"" << wavog::toString(config.map.policy.type) << "\""
        << ",\n  \"resolution_m\": " << wavog_tools::jsonNumber(config.map.grid.resolution)
@@ -647,8 +687,8 @@ int run(const Options& o) {
     std::cerr << std::fixed << std::setprecision(2) << "wavog_offline: " << s.integrated()
               << " scans integrated, " << dropped_total << " dropped, in " << wall_s << " s ("
               << std::setprecision(0)
-              << (loop_s > 0 ? static_cast<double>(s.integrated()) / loop_s : 0.0)
-              << " scans/s); " << stats.bytes << " bytes, " << std::setprecision(3) << per_cell
+              << (loop_s > 0 ? static_cast<double>(s.integrated()) / loop_s : 0.0) << " scans/s); "
+              << stats.bytes << " bytes, " << std::setprecision(3) << per_cell
               << " bytes per observed cell; wrote " << o.out << "/\n";
     for (const auto& [reason, n] : s.dropped()) {
       std::cerr << "wavog_offline:   dropped " << n << " (" << reason << ")\n";

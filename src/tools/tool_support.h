@@ -24,11 +24,11 @@ double wrapAngle(double a);
 
 /// One laser of a CARMEN log and how it appears in ROS.
 struct CarmenLaser {
-  std::string type;   ///< "FLASER", "RLASER" or "ROBOTLASER1"
-  std::string frame;  ///< frame id, e.g. "front_laser" (no leading slash)
-  std::string topic;  ///< topic, e.g. "/front_laser/scan"
+  std::string type;       ///< "FLASER", "RLASER" or "ROBOTLASER1"
+  std::string frame;      ///< frame id, e.g. "front_laser" (no leading slash)
+  std::string topic;      ///< topic, e.g. "/front_laser/scan"
   std::size_t scans = 0;  ///< scans of this type in the log
-  bool used = true;   ///< false: ROBOTLASER1 repeating the FLASER laser (skipped)
+  bool used = true;       ///< false: ROBOTLASER1 repeating the FLASER laser (skipped)
   /// Laser pose in base_link: robot_pose^-1 * laser_pose of its first scan (identity when the
   /// log's robot pose is not in the laser pose's frame: offset > kMaxMountOffset).
   wavog::Pose2 mount;
@@ -37,8 +37,8 @@ struct CarmenLaser {
 
 /// What a first pass over a CARMEN log found.
 struct CarmenLogPlan {
-  std::vector<CarmenLaser> lasers;  ///< in order of first appearance
-  std::size_t scans_used = 0;       ///< scans of the used lasers (all of the log)
+  std::vector<CarmenLaser> lasers;     ///< in order of first appearance
+  std::size_t scans_used = 0;          ///< scans of the used lasers (all of the log)
   std::size_t skipped_duplicates = 0;  ///< ROBOTLASER1 scans skipped because FLASER is present
   std::string read_error;  ///< a truncated / corrupted stream met by the first pass (else empty)
   /// The laser of a scan type, or nullptr if that type is not used.

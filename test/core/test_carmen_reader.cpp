@@ -100,8 +100,8 @@ std::string ranges(int n, const std::string& value) {
 /// A well-formed FLASER line with n beams, all reading `value`.
 std::string flaser(int n, const std::string& value, double t, const char* type = "FLASER") {
   std::ostringstream s;
-  s << type << " " << n << " " << ranges(n, value) << "1.5 -2.25 0.5 1.0 2.0 0.25 " << t
-    << " host " << t + 0.001;
+  s << type << " " << n << " " << ranges(n, value) << "1.5 -2.25 0.5 1.0 2.0 0.25 " << t << " host "
+    << t + 0.001;
   return s.str();
 }
 
@@ -285,8 +285,8 @@ TEST(CarmenReader, MalformedLinesNameFileAndLine) {
       {"ROBOTLASER1 0 -0.5 1.0 0.25 50 0.01 0 4 1 2 3 4 9 0.1", "missing field 'remission'"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
-    const std::string path =
-        tmp.file("bad" + std::to_string(i) + ".log", good + "\n# c\n" + cases[i].line + "\n" + good);
+    const std::string path = tmp.file("bad" + std::to_string(i) + ".log",
+                                      good + "\n# c\n" + cases[i].line + "\n" + good);
     std::size_t line = 0;
     const std::string msg = catchMessage(path, true, &line);
     EXPECT_EQ(msg.rfind(path + ":3: ", 0), 0u) << "case " << i << ": " << msg;
@@ -297,8 +297,9 @@ TEST(CarmenReader, MalformedLinesNameFileAndLine) {
 
 TEST(CarmenReader, LenientModeSkipsAndRecordsMalformedLines) {
   TempDir tmp;
-  const std::string log = flaser(180, "1.0", 1.0) + "\nFLASER 180 oops\n" + flaser(180, "2.0", 2.0) +
-                          "\nROBOTLASER1 0\n" + flaser(180, "3.0", 3.0) + "\n";
+  const std::string log = flaser(180, "1.0", 1.0) + "\nFLASER 180 oops\n" +
+                          flaser(180, "2.0", 2.0) + "\nROBOTLASER1 0\n" + flaser(180, "3.0", 3.0) +
+                          "\n";
   const std::string path = tmp.file("lenient.log", log);
   wavog::CarmenReader reader(path, false);
   std::vector<float> first_ranges;

@@ -97,8 +97,10 @@ TEST_F(ImageIo, RenderRgbShowsUnknownInColour) {
 TEST_F(ImageIo, PngRoundTripGreyAndRgb) {
   wavog::Image grey(37, 11, 1);
   wavog::Image rgb(5, 300, 3);
-  for (std::size_t i = 0; i < grey.pixels.size(); ++i) grey.pixels[i] = static_cast<std::uint8_t>(i * 7);
-  for (std::size_t i = 0; i < rgb.pixels.size(); ++i) rgb.pixels[i] = static_cast<std::uint8_t>(i * 13 + 1);
+  for (std::size_t i = 0; i < grey.pixels.size(); ++i)
+    grey.pixels[i] = static_cast<std::uint8_t>(i * 7);
+  for (std::size_t i = 0; i < rgb.pixels.size(); ++i)
+    rgb.pixels[i] = static_cast<std::uint8_t>(i * 13 + 1);
   wavog::writePng(path("g.png"), grey);
   wavog::writePng(path("c.png"), rgb);
   const wavog::Image g = wavog::readPng(path("g.png"));

@@ -3,6 +3,10 @@
 // counts, types, strictly increasing stamps, frames, REP 117 ranges, tf composing to the logged
 // laser pose); malformed lines (lenient and --strict); a truncated .gz; time stamp repairs.
 #include <gtest/gtest.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -13,11 +17,6 @@
 #include <map>
 #include <string>
 #include <vector>
-
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
-#include <sensor_msgs/LaserScan.h>
-#include <tf2_msgs/TFMessage.h>
 
 #include "tool_support.h"
 #include "wavog_mapping/io/carmen_reader.h"
@@ -223,8 +222,8 @@ TEST(Log2Bag, TruncatedGzipIsAnErrorAndKeepsTheScansBeforeIt) {
 }
 
 TEST(Log2Bag, RepairsStampsAndReportsEachKindOnce) {
-  const std::string log = writeLog(
-      "stamps.log", {flaser(5.0), flaser(5.0), flaser(4.9), flaser(0.0), flaser(5.5)});
+  const std::string log =
+      writeLog("stamps.log", {flaser(5.0), flaser(5.0), flaser(4.9), flaser(0.0), flaser(5.5)});
   const std::string bag = (workDir() / "stamps.bag").string();
   const RunResult r = runLog2Bag("--rate 20 --epoch 1000000000 " + log + " " + bag);
   ASSERT_EQ(r.status, 0) << r.err;

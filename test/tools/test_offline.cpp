@@ -4,6 +4,11 @@
 // frame "/laser") maps with --fixed-frame laser and its zero readings are rejected (REP 117); clear
 // errors for a missing file, a missing topic and tf that never connects.
 #include <gtest/gtest.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2/buffer_core.h>
+#include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -13,12 +18,6 @@
 #include <iterator>
 #include <string>
 #include <vector>
-
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
-#include <sensor_msgs/LaserScan.h>
-#include <tf2/buffer_core.h>
-#include <tf2_msgs/TFMessage.h>
 
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
@@ -112,8 +111,8 @@ class OfflineFr079 : public ::testing::Test {
     const RunResult c = run(WAVOG_LOG2BAG, "--quiet --max-scans 300 " + log_ + " " + bag_);
     ASSERT_EQ(c.status, 0) << c.err;
     out_ = (workDir() / "fr079_bag").string();
-    bag_run_ = run(WAVOG_OFFLINE, "--no-progress --snapshot-every 5 --scale 0,2 -o " + out_ + " " +
-                                      bag_);
+    bag_run_ =
+        run(WAVOG_OFFLINE, "--no-progress --snapshot-every 5 --scale 0,2 -o " + out_ + " " + bag_);
   }
 
   static std::string log_;
@@ -148,7 +147,8 @@ TEST_F(OfflineFr079, BagMapEqualsTheCoreMapFromTheLog) {
     tf2::BufferCore tf(ros::Duration(3600.0));
     for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
       if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
-        for (const auto& t : msg->transforms) tf.setTransform(t, "test", m.getTopic() == "/tf_static");
+        for (const auto& t : msg->transforms)
+          tf.setTransform(t, "test", m.getTopic() == "/tf_static");
       }
     }
     std::size_t i = 0;
@@ -159,13 +159,13 @@ TEST_F(OfflineFr079, BagMapEqualsTheCoreMapFromTheLog) {
       ASSERT_LT(i, logged.size());
       const auto t = tf.lookupTransform("map", scan->header.frame_id, scan->header.stamp);
       const auto& q = t.transform.rotation;
-      const wavog::Pose2 pose{t.transform.translation.x, t.transform.translation.y,
-                              std::atan2(2.0 * (q.x * q.y + q.z * q.w),
-                                         1.0 - 2.0 * (q.y * q.y + q.z * q.z))};
-      max_dxy = std::max(max_dxy, std::hypot(pose.x - logged[i].laser_pose.x,
-                                             pose.y - logged[i].laser_pose.y));
-      max_dtheta = std::max(max_dtheta, std::fabs(std::remainder(
-                                            pose.theta - logged[i].laser_pose.theta, 2 * M_PI)));
+      const wavog::Pose2 pose{
+          t.transform.translation.x, t.transform.translation.y,
+          std::atan2(2.0 * (q.x * q.y + q.z * q.w), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))};
+      max_dxy = std::max(
+          max_dxy, std::hypot(pose.x - logged[i].laser_pose.x, pose.y - logged[i].laser_pose.y));
+      max_dtheta = std::max(
+          max_dtheta, std::fabs(std::remainder(pose.theta - logged[i].laser_pose.theta, 2 * M_PI)));
       wavog::ScanView view;
       view.ranges = scan->ranges.data();
       view.count = scan->ranges.size();
@@ -187,8 +187,9 @@ TEST_F(OfflineFr079, BagMapEqualsTheCoreMapFromTheLog) {
   EXPECT_GT(d.cells, 100000u);
   // Against the map of the logged values, the round-off of those two conversions (~1e-16 rad)
   // may flip a rare cell that lies on a classification boundary, nothing more.
-  EXPECT_LE(d.known_mismatch + d.value_mismatch, d.cells / 100000) << "cells " << d.cells
-      << " known mismatch " << d.known_mismatch << " value mismatch " << d.value_mismatch;
+  EXPECT_LE(d.known_mismatch + d.value_mismatch, d.cells / 100000)
+      << "cells " << d.cells << " known mismatch " << d.known_mismatch << " value mismatch "
+      << d.value_mismatch;
   RecordProperty("cells", static_cast<int>(d.cells));
   RecordProperty("mismatch", static_cast<int>(d.known_mismatch + d.value_mismatch));
   std::cout << "offline(bag) vs core(log): " << d.cells << " cells, " << d.known_mismatch
@@ -219,15 +220,16 @@ TEST_F(OfflineFr079, WritesPicturesMapServerFilesSummaryAndSnapshots) {
   EXPECT_NE(yaml.find("resolution: 0.05"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("negate: 0\n"), std::string::npos) << yaml;
   const std::string json = readText(out / "summary.json");
-  for (const char* key :
-       {"\"scans_integrated\": 300", "\"scans_dropped\": 0", "\"input_type\": \"bag\"",
-        "\"topics\": [\"/front_laser/scan\"]", "\"wall_time_s\"", "\"scans_per_s\"",
-        "\"bytes_per_observed_cell\"", "\"nodes\"", "\"policy\": \"forget\"", "\"snapshots\": [\"snapshots/"}) {
+  for (const char* key : {"\"scans_integrated\": 300", "\"scans_dropped\": 0",
+                          "\"input_type\": \"bag\"", "\"topics\": [\"/front_laser/scan\"]",
+                          "\"wall_time_s\"", "\"scans_per_s\"", "\"bytes_per_observed_cell\"",
+                          "\"nodes\"", "\"policy\": \"forget\"", "\"snapshots\": [\"snapshots/"}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
   }
   // 300 scans of fr079 span about 64 s of log time: snapshots at 0, 5, 10, ... s.
   std::size_t snapshots = 0;
-  for (const auto& e : fs::directory_iterator(out / "snapshots")) snapshots += e.path().extension() == ".png";
+  for (const auto& e : fs::directory_iterator(out / "snapshots"))
+    snapshots += e.path().extension() == ".png";
   EXPECT_GE(snapshots, 10u);
   EXPECT_TRUE(fs::exists(out / "snapshots" / "t00000.0_s0.png"));
 }
@@ -235,8 +237,10 @@ TEST_F(OfflineFr079, WritesPicturesMapServerFilesSummaryAndSnapshots) {
 TEST_F(OfflineFr079, CarmenLogDirectlyWithPolicyAndScaleOptions) {
   ASSERT_FALSE(log_.empty());
   const std::string out = (workDir() / "fr079_log").string();
-  const RunResult r = run(WAVOG_OFFLINE, "--no-progress --max-scans 300 --policy clamp --scale 1 "
-                                         "--aggregation max -o " + out + " " + log_);
+  const RunResult r = run(WAVOG_OFFLINE,
+                          "--no-progress --max-scans 300 --policy clamp --scale 1 "
+                          "--aggregation max -o " +
+                              out + " " + log_);
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string json = readText(fs::path(out) / "summary.json");
   EXPECT_NE(json.find("\"input_type\": \"carmen\""), std::string::npos) << json;
@@ -265,7 +269,8 @@ TEST(Offline, LaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) {
   RunResult r = run(WAVOG_OFFLINE, "--no-progress -o " + out + " " + bag);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("tf never connects the scan frame 'laser' to the fixed frame 'map'"),
-            std::string::npos) << r.err;
+            std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("the bag has no /tf or /tf_static"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--fixed-frame"), std::string::npos) << r.err;
 
@@ -292,7 +297,8 @@ TEST(Offline, LaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) {
   const std::string json = readText(fs::path(out) / "summary.json");
   EXPECT_NE(json.find("\"scans_integrated\": 360"), std::string::npos) << json;
   EXPECT_NE(json.find("\"invalid\": " + std::to_string(invalid) + "}"), std::string::npos)
-      << "expected " << invalid << " invalid beams (" << zeros << " zeros)\n" << json;
+      << "expected " << invalid << " invalid beams (" << zeros << " zeros)\n"
+      << json;
   EXPECT_NE(json.find("\"fixed_frame\": \"laser\""), std::string::npos) << json;
   // No cell at the laser's own position is occupied: zero readings never became hits.
   wavog::WaveletMap map(defaultParams());

@@ -3,16 +3,15 @@
 // checks that the finest maps agree: the same observed cells and the same occupied cells, except
 // the few that depend on the tf interpolation.
 #include <gtest/gtest.h>
+#include <ros/ros.h>
 #include <unistd.h>
+#include <xmlrpcpp/XmlRpcValue.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
 #include <string>
-
-#include <ros/ros.h>
-#include <xmlrpcpp/XmlRpcValue.h>
 
 #include "wavog_mapping/MapperStatus.h"
 #include "wavog_mapping/SaveMap.h"
@@ -23,8 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kWaitSeconds = 120.0;   // wall time for the node to integrate the scans
-constexpr double kOccupiedProb = 0.65;   // a cell is occupied above this P(occ) (map_server's)
+constexpr double kWaitSeconds = 120.0;     // wall time for the node to integrate the scans
+constexpr double kOccupiedProb = 0.65;     // a cell is occupied above this P(occ) (map_server's)
 constexpr double kMaxDisagreement = 0.01;  // of the occupied cells
 
 std::mutex g_mutex;
@@ -55,7 +54,6 @@ TEST(Playback, NodeMapAgreesWithOfflineMap) {
   ros::Subscriber sub = nh.subscribe("/wavog_mapping/status", 10, onStatus);
   const ros::WallTime started = ros::WallTime::now();
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kWaitSeconds);
-  std::uint64_t received = 0;
   std::uint64_t integrated = 0;
   wavog_mapping::InputStatus input;
   while (ros::ok() && ros::WallTime::now() < deadline) {
@@ -63,7 +61,6 @@ TEST(Playback, NodeMapAgreesWithOfflineMap) {
       std::lock_guard<std::mutex> lock(g_mutex);
       if (g_status && !g_status->inputs.empty()) {
         input = g_status->inputs[0];
-        received = input.received;
         integrated = input.integrated;
       }
     }
@@ -71,7 +68,8 @@ TEST(Playback, NodeMapAgreesWithOfflineMap) {
     ros::WallDuration(0.05).sleep();
   }
   const double waited = (ros::WallTime::now() - started).toSec();
-  ASSERT_EQ(integrated, static_cast<std::uint64_t>(scans)) << "last status of the input:\n" << input;
+  ASSERT_EQ(integrated, static_cast<std::uint64_t>(scans)) << "last status of the input:\n"
+                                                           << input;
 
   ros::ServiceClient save = nh.serviceClient<wavog_mapping::SaveMap>("/wavog_mapping/save_map");
   ASSERT_TRUE(save.waitForExistence(ros::Duration(10.0)));
@@ -80,7 +78,6 @@ TEST(Playback, NodeMapAgreesWithOfflineMap) {
   ASSERT_TRUE(save.call(srv));
   ASSERT_TRUE(srv.response.success) << srv.response.message;
 
-  XmlRpc::XmlRpcValue empty;
   const wavog::MapParams params = wavog_ros::loadConfigFile(config, nullptr).map;
   wavog::WaveletMap node(params);
   wavog::WaveletMap offline(params);

@@ -41,9 +41,9 @@ TEST(StampRepair, ShiftsRelativeStampsAndKeepsAbsoluteOnes) {
 TEST(StampRepair, ClampsBackwardStepsAndSynthesisesMissingStamps) {
   wavog_tools::StampRepair r(20.0, 1000.0);
   const double a = r.repair(2e9);
-  const double b = r.repair(2e9);          // equal: clamped
-  const double c = r.repair(2e9 - 0.05);   // backward: clamped
-  const double d = r.repair(0.0);          // missing: + 1 / rate
+  const double b = r.repair(2e9);         // equal: clamped
+  const double c = r.repair(2e9 - 0.05);  // backward: clamped
+  const double d = r.repair(0.0);         // missing: + 1 / rate
   const double e = r.repair(std::nan(""));
   EXPECT_GT(b, a);
   EXPECT_GT(c, b);
@@ -71,8 +71,8 @@ TEST(StampRepair, KeepsTheLoggedMicroseconds) {
 }
 
 TEST(CarmenLogPlan, FrontRearAndDuplicateRobotLaser) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("wavog_plan_" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("wavog_plan_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "plan.log").string();
   {

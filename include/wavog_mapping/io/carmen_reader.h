@@ -16,16 +16,16 @@ namespace wavog {
 
 /// One laser scan of a CARMEN log.
 struct CarmenScan {
-  std::string type;         ///< "FLASER", "RLASER" or "ROBOTLASER1"
-  std::size_t line = 0;     ///< 1-based line number in the log
+  std::string type;               ///< "FLASER", "RLASER" or "ROBOTLASER1"
+  std::size_t line = 0;           ///< 1-based line number in the log
   double ipc_timestamp = 0.0;     ///< ipc time stamp (s), as logged
   double logger_timestamp = 0.0;  ///< logger time stamp (s), as logged
-  Pose2 laser_pose;         ///< laser pose in the map frame (corrected logs: corrected)
-  Pose2 robot_pose;         ///< robot pose: odometry pose for FLASER/RLASER, robot pose for
-                            ///< ROBOTLASER1
-  double angle_min = 0.0;   ///< bearing of the first beam in the laser frame (rad)
-  double angle_increment = 0.0;  ///< bearing step (rad)
-  double range_max = 0.0;   ///< readings at or above are no return (m), at most kNoReturnRange
+  Pose2 laser_pose;               ///< laser pose in the map frame (corrected logs: corrected)
+  Pose2 robot_pose;               ///< robot pose: odometry pose for FLASER/RLASER, robot pose for
+                                  ///< ROBOTLASER1
+  double angle_min = 0.0;         ///< bearing of the first beam in the laser frame (rad)
+  double angle_increment = 0.0;   ///< bearing step (rad)
+  double range_max = 0.0;  ///< readings at or above are no return (m), at most kNoReturnRange
   /// Ranges as logged (m). The no-return sentinels (81.91, ...) stay as logged: they are >=
   /// range_max, which is "no return" per REP 117 (see isNoReturn()).
   std::vector<float> ranges;

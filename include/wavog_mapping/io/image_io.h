@@ -21,15 +21,21 @@ struct Image {
   std::vector<std::uint8_t> pixels;  ///< width * height * channels bytes
 
   Image() = default;
-  Image(int w, int h, int c) : width(w), height(h), channels(c),
-      pixels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * static_cast<std::size_t>(c)) {}
+  Image(int w, int h, int c)
+      : width(w),
+        height(h),
+        channels(c),
+        pixels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) *
+               static_cast<std::size_t>(c)) {}
   std::uint8_t* at(int x, int y) {
     return &pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                    static_cast<std::size_t>(x)) * static_cast<std::size_t>(channels)];
+                    static_cast<std::size_t>(x)) *
+                   static_cast<std::size_t>(channels)];
   }
   const std::uint8_t* at(int x, int y) const {
     return &pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                    static_cast<std::size_t>(x)) * static_cast<std::size_t>(channels)];
+                    static_cast<std::size_t>(x)) *
+                   static_cast<std::size_t>(channels)];
   }
 };
 
@@ -73,9 +79,9 @@ Image readPgm(const std::string& path);
 
 /// The fields of a map_server map YAML.
 struct MapServerYaml {
-  std::string image;              ///< image file, relative to the YAML's folder
-  double resolution = 0.05;       ///< metres per pixel
-  double origin_x = 0.0;          ///< map-frame position of the lower-left pixel's corner (m)
+  std::string image;         ///< image file, relative to the YAML's folder
+  double resolution = 0.05;  ///< metres per pixel
+  double origin_x = 0.0;     ///< map-frame position of the lower-left pixel's corner (m)
   double origin_y = 0.0;
   double origin_yaw = 0.0;        ///< rad
   int negate = 0;                 ///< 0: white is free, black occupied
