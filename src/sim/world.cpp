@@ -10,7 +10,6 @@ namespace {
 
 using Points = std::vector<Vec2, Eigen::aligned_allocator<Vec2>>;
 
-constexpr double kDeg = M_PI / 180.0;
 // Passenger car and truck sizes of the default world (m).
 constexpr double kCarLength = 4.4;
 constexpr double kCarWidth = 1.8;

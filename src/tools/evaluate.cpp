@@ -144,7 +144,6 @@ std::string jsonNumber(double v) {
 // ---- Pictures -----------------------------------------------------------------------------
 
 const Rgb kBlack{0, 0, 0};
-const Rgb kWhite{255, 255, 255};
 const Rgb kGrey{150, 150, 150};
 // One colour per run, distinguishable on white.
 const Rgb kPalette[] = {{0, 0, 0},      {230, 159, 0}, {160, 110, 0},  {86, 180, 233},
@@ -229,12 +228,15 @@ Image plotEvent(const WorldEvent& event, std::size_t k, const std::vector<Policy
   drawLine(&img, px(event.event_time), kTop, px(event.event_time), kTop + ph, kGrey, 1, 4);
   drawText(&img, px(event.event_time) + 4, kTop + 2, departure ? "stall clear" : "parked", kGrey,
            2);
-  for (double p = 0.0; p <= 1.0001; p += 0.25) {
+  for (int tick = 0; tick <= 4; ++tick) {
+    const double p = 0.25 * tick;
     drawLine(&img, kLeft - 5, py(p), kLeft, py(p), kBlack);
     drawText(&img, 8, py(p) - 5, fixed(p, 2), kBlack, 2);
   }
   const double step = (t_end - t0) > 40 ? 10.0 : (t_end - t0) > 10 ? 5.0 : 1.0;
-  for (double t = std::ceil(t0 / step) * step; t <= t_end + 1e-9; t += step) {
+  const auto first_tick = static_cast<int>(std::ceil(t0 / step));
+  for (int tick = first_tick; tick * step <= t_end + 1e-9; ++tick) {
+    const double t = tick * step;
     drawLine(&img, px(t), kTop + ph, px(t), kTop + ph + 5, kBlack);
     const std::string label = fixed(t, 0);
     drawText(&img, px(t) - textWidth(label) / 2, kTop + ph + 9, label, kBlack, 2);

@@ -64,7 +64,7 @@ void usage(std::ostream& out) {
          "  --dropout P           NaN dropout probability per beam for every laser\n"
          "  --map-frame F         fixed frame of /tf (default map)\n"
          "  --base-frame F        vehicle frame (default base_link)\n"
-         "  --truth-dir DIR       write ground truth there: world.yaml, truth_<t>.png/.pgm/.yaml\n"
+         "  --truth-dir DIR       write ground truth there: world.yaml, truth_<t>s.png/.pgm/.yaml\n"
          "  --truth-resolution R  ground-truth cell size (m, default 0.1)\n"
          "  --truth-every S       ground-truth snapshot period (s, default 10)\n"
          "  --write-world FILE    write the world as YAML (e.g. to edit the default) and go on\n";
@@ -164,7 +164,8 @@ void writeTruth(const World& world, const Options& o) {
   std::ofstream(o.truth_dir + "/world.yaml") << wavog::sim::worldToYaml(world);
   const GridWindow window =
       GridWindow::covering(world.region_min, world.region_max, o.truth_resolution);
-  for (double t = 0.0; t < world.duration + 1e-9; t += o.truth_every) {
+  for (int k = 0; k * o.truth_every < world.duration + 1e-9; ++k) {
+    const double t = k * o.truth_every;
     const std::vector<std::uint8_t> occ = wavog::sim::occupancyAt(world, t, window);
     // As a raster, so the image writers put north up and the map_server YAML gets the origin.
     wavog::Raster raster;
@@ -175,8 +176,8 @@ void writeTruth(const World& world, const Options& o) {
     raster.known.assign(occ.size(), 1);
     for (std::size_t i = 0; i < occ.size(); ++i) raster.log_odds[i] = occ[i] ? 20.0f : -20.0f;
     std::ostringstream base;
-    base << o.truth_dir << "/truth_" << std::setw(4) << std::setfill('0')
-         << static_cast<int>(std::lround(t)) << "s";
+    base << o.truth_dir << "/truth_" << std::fixed << std::setprecision(1) << std::setw(6)
+         << std::setfill('0') << t << "s";
     wavog::writePng(base.str() + ".png", wavog::renderGrey(raster));
     wavog::writeMapServerMap(base.str(), raster);
   }
