@@ -2,6 +2,8 @@
 // the list of known keys, the type checks and the error messages cannot drift apart.
 #include "wavog_mapping/ros/config.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -9,8 +11,6 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
-
-#include <yaml-cpp/yaml.h>
 
 namespace wavog_ros {
 namespace {
@@ -90,7 +90,8 @@ std::vector<InputConfig> asInputs(const std::string& key, XmlRpcValue& v) {
 std::vector<int> asIntList(const std::string& key, XmlRpcValue& v) {
   if (v.getType() != XmlRpcValue::TypeArray) typeError(key, v, "a list of integers");
   std::vector<int> out;
-  for (int i = 0; i < v.size(); ++i) out.push_back(asInt(key + "[" + std::to_string(i) + "]", v[i]));
+  for (int i = 0; i < v.size(); ++i)
+    out.push_back(asInt(key + "[" + std::to_string(i) + "]", v[i]));
   return out;
 }
 
@@ -123,14 +124,16 @@ const std::vector<KeyReader>& readers() {
       // ---- core: sensor model
       {"odd_occ", [](auto& k, auto& v, Config* c) { c->map.sensor.odd_occ = asDouble(k, v); }},
       {"odd_emp", [](auto& k, auto& v, Config* c) { c->map.sensor.odd_emp = asDouble(k, v); }},
-      {"band_width", [](auto& k, auto& v, Config* c) { c->map.sensor.band_width = asDouble(k, v); }},
+      {"band_width",
+       [](auto& k, auto& v, Config* c) { c->map.sensor.band_width = asDouble(k, v); }},
       {"max_range", [](auto& k, auto& v, Config* c) { c->map.sensor.max_range = asDouble(k, v); }},
       {"no_return_clear",
        [](auto& k, auto& v, Config* c) { c->map.sensor.no_return_clear = asDouble(k, v); }},
       // ---- core: compression and forgetting
       {"prune_threshold",
        [](auto& k, auto& v, Config* c) { c->map.prune_threshold = asDouble(k, v); }},
-      {"skip_tolerance", [](auto& k, auto& v, Config* c) { c->map.skip_tolerance = asDouble(k, v); }},
+      {"skip_tolerance",
+       [](auto& k, auto& v, Config* c) { c->map.skip_tolerance = asDouble(k, v); }},
       {"lazy_forgetting",
        [](auto& k, auto& v, Config* c) { c->map.lazy_forgetting = asBool(k, v); }},
       // ---- ROS
@@ -245,9 +248,9 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
   std::vector<std::string> e;
   check(!ros.map_frame.empty() && ros.map_frame[0] != '/', &e,
         "map_frame ('" + ros.map_frame + "') must be a non-empty tf2 frame id without leading '/'");
-  check(!ros.base_frame.empty() && ros.base_frame[0] != '/', &e,
-        "base_frame ('" + ros.base_frame +
-            "') must be a non-empty tf2 frame id without leading '/'");
+  check(
+      !ros.base_frame.empty() && ros.base_frame[0] != '/', &e,
+      "base_frame ('" + ros.base_frame + "') must be a non-empty tf2 frame id without leading '/'");
   const int n = static_cast<int>(ros.inputs.size());
   check(n >= 1 && n <= kMaxInputs, &e,
         "inputs (" + std::to_string(n) + " entries) must have 1 to " + std::to_string(kMaxInputs) +
@@ -261,13 +264,13 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
     check(std::isfinite(in.expected_rate) && in.expected_rate >= 0.0 && in.expected_rate <= 1000.0,
           &e, name + ".expected_rate (" + fmt(in.expected_rate) + ") must be in [0, 1000] Hz");
   }
-  check(std::isfinite(ros.publish_rate) && ros.publish_rate > 0.0 && ros.publish_rate <= 100.0,
-        &e, "publish_rate (" + fmt(ros.publish_rate) + ") must be in (0, 100] Hz");
+  check(std::isfinite(ros.publish_rate) && ros.publish_rate > 0.0 && ros.publish_rate <= 100.0, &e,
+        "publish_rate (" + fmt(ros.publish_rate) + ") must be in (0, 100] Hz");
   std::set<int> scales;
   for (int s : ros.publish_scales) {
     check(s >= 1 && s <= map.grid.block_levels, &e,
-          "publish_scales entry (" + std::to_string(s) + ") must be in [1, block_levels = " +
-              std::to_string(map.grid.block_levels) + "]");
+          "publish_scales entry (" + std::to_string(s) +
+              ") must be in [1, block_levels = " + std::to_string(map.grid.block_levels) + "]");
     check(scales.insert(s).second, &e,
           "publish_scales entry (" + std::to_string(s) + ") is listed twice");
   }
@@ -277,8 +280,7 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
         "update_rate (" + fmt(ros.update_rate) + ") must be in [0, 100] Hz (0: off)");
   check(std::isfinite(ros.tf_tolerance) && ros.tf_tolerance >= 0.0 && ros.tf_tolerance <= 1.0, &e,
         "tf_tolerance (" + fmt(ros.tf_tolerance) + ") must be in [0, 1] s");
-  check(std::isfinite(ros.tf_cache_time) && ros.tf_cache_time >= 1.0 &&
-            ros.tf_cache_time <= 3600.0,
+  check(std::isfinite(ros.tf_cache_time) && ros.tf_cache_time >= 1.0 && ros.tf_cache_time <= 3600.0,
         &e, "tf_cache_time (" + fmt(ros.tf_cache_time) + ") must be in [1, 3600] s");
   check(ros.queue_size >= 1 && ros.queue_size <= 1000, &e,
         "queue_size (" + std::to_string(ros.queue_size) + ") must be in [1, 1000]");

@@ -1,11 +1,11 @@
 // Message <-> core conversions (see conversions.h).
 #include "wavog_mapping/ros/conversions.h"
 
-#include <boost/make_shared.hpp>
-#include <cmath>
-
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
+
+#include <boost/make_shared.hpp>
+#include <cmath>
 
 namespace wavog_ros {
 

@@ -1,8 +1,8 @@
 // The mapper as a standalone node: the same MappingRos as the nodelet, callbacks on 4 threads.
 // Exits 1 on a bad configuration or map_file, after a message naming the parameter.
-#include <exception>
-
 #include <ros/ros.h>
+
+#include <exception>
 
 #include "wavog_mapping/ros/mapping_ros.h"
 

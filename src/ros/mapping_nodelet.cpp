@@ -1,7 +1,7 @@
 // The mapper as a nodelet: a thin wrapper over MappingRos on the multi-threaded node handles.
-#include <memory>
-
 #include <nodelet/nodelet.h>
+
+#include <memory>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "wavog_mapping/ros/mapping_ros.h"

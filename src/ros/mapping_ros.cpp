@@ -1,18 +1,6 @@
 // MappingRos (see mapping_ros.h): messages in, core calls, messages out.
 #include "wavog_mapping/ros/mapping_ros.h"
 
-#include <algorithm>
-#include <array>
-#include <chrono>
-#include <cmath>
-#include <map>
-#include <mutex>
-#include <sstream>
-#include <string>
-#include <vector>
-
-#include <boost/make_shared.hpp>
-#include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
 #include <dynamic_reconfigure/server.h>
@@ -24,6 +12,18 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_listener.h>
+
+#include <algorithm>
+#include <array>
+#include <boost/make_shared.hpp>
+#include <boost/thread/recursive_mutex.hpp>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"
@@ -177,7 +177,9 @@ struct MappingRos::Impl {
 };
 
 MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
-    : nh_(nh), pnh_(pnh), config_([&] {
+    : nh_(nh),
+      pnh_(pnh),
+      config_([&] {
         std::vector<std::string> unknown;
         Config c = loadConfig(pnh, &unknown);
         for (const auto& key : unknown) {
@@ -234,9 +236,9 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
         boost::function<void(const LaserScan::ConstPtr&)>(
             [this, raw](const LaserScan::ConstPtr& scan) { onScan(raw, scan); }),
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-    updater_->add(in->topic + " input", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {
-      diagnoseInput(raw, s);
-    });
+    updater_->add(
+        in->topic + " input",
+        [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseInput(raw, s); });
     if (ic.expected_rate > 0.0) {
       auto freq = std::make_unique<diagnostic_updater::FrequencyStatus>(
           diagnostic_updater::FrequencyStatusParam(&raw->min_freq, &raw->max_freq, 0.0, 5),
@@ -265,25 +267,24 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   rc.publish_rate = ros.publish_rate;
   rc.scales = joinScales(ros.publish_scales);
   reconfigure_->updateConfig(rc);
-  reconfigure_->setCallback([this](wavog_mapping::MappingConfig& c, std::uint32_t level) {
-    onReconfigure(c, level);
-  });
+  reconfigure_->setCallback(
+      [this](wavog_mapping::MappingConfig& c, std::uint32_t level) { onReconfigure(c, level); });
 
   last_status_time_ = ros::Time::now();
-  publish_timer_ = nh_.createTimer(ros::Duration(1.0 / ros.publish_rate), &Impl::onPublishTimer, this);
+  publish_timer_ =
+      nh_.createTimer(ros::Duration(1.0 / ros.publish_rate), &Impl::onPublishTimer, this);
   if (ros.update_rate > 0.0) {
-    update_timer_ = nh_.createTimer(ros::Duration(1.0 / ros.update_rate), &Impl::onUpdateTimer, this);
+    update_timer_ =
+        nh_.createTimer(ros::Duration(1.0 / ros.update_rate), &Impl::onUpdateTimer, this);
   }
-  diag_timer_ = nh_.createTimer(ros::Duration(0.5), [this](const ros::TimerEvent&) {
-    updater_->update();
-  });
+  diag_timer_ =
+      nh_.createTimer(ros::Duration(0.5), [this](const ros::TimerEvent&) { updater_->update(); });
 
   std::string topics;
   for (const auto& in : inputs_) topics += " " + in->topic;
   ROS_INFO("%s: mapping%s into '%s' (policy %s, resolution %g m), publishing at %g Hz",
            pnh_.getNamespace().c_str(), topics.c_str(), ros.map_frame.c_str(),
-           wavog::toString(config_.map.policy.type), config_.map.grid.resolution,
-           ros.publish_rate);
+           wavog::toString(config_.map.policy.type), config_.map.grid.resolution, ros.publish_rate);
 }
 
 MappingRos::Impl::~Impl() {
@@ -355,8 +356,8 @@ void MappingRos::Impl::onScan(Input* in, const LaserScan::ConstPtr& scan) {
   in->filter->add(scan);
 }
 
-void MappingRos::Impl::onFilterFailure(Input* in,
-                                       tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+void MappingRos::Impl::onFilterFailure(
+    Input* in, tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
   std::lock_guard<std::mutex> lock(mutex_);
   switch (reason) {
     case tf2_ros::filter_failure_reasons::OutTheBack:
@@ -495,7 +496,8 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
       cy = t.transform.translation.y;
     } catch (const tf2::TransformException& e) {
       window_ok = false;
-      ROS_WARN_THROTTLE(kWarnPeriod, "%s: no pose of '%s' for publish_window, maps not published: %s",
+      ROS_WARN_THROTTLE(kWarnPeriod,
+                        "%s: no pose of '%s' for publish_window, maps not published: %s",
                         pnh_.getNamespace().c_str(), ros.base_frame.c_str(), e.what());
     }
   }
@@ -526,11 +528,11 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
       } else {
         have = map_.bounds(job.scale, &box);
       }
-      job.raster = have && !box.empty()
-                       ? map_.exportScale(job.scale, box,
-                                          job.scale == 0 ? wavog::Aggregation::kMean
-                                                         : ros.scale_aggregation)
-                       : emptyRaster(job.scale, map_.resolution());
+      job.raster =
+          have && !box.empty()
+              ? map_.exportScale(job.scale, box,
+                                 job.scale == 0 ? wavog::Aggregation::kMean : ros.scale_aggregation)
+              : emptyRaster(job.scale, map_.resolution());
       if (job.scale == 0) {
         // The dirty region is reset by map_updates only: re-sending an area the full map already
         // carries is harmless, while two timers of the same period would otherwise starve updates.
@@ -573,8 +575,8 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
       status->clock_jumps = clock_jumps_;
       status->inputs.push_back(s);
     }
-    last_mean_ = integrate_count_ > 0 ? integrate_time_sum_ / static_cast<double>(integrate_count_)
-                                      : 0.0;
+    last_mean_ =
+        integrate_count_ > 0 ? integrate_time_sum_ / static_cast<double>(integrate_count_) : 0.0;
     last_max_ = integrate_time_max_;
     status->integrate_time_mean = last_mean_;
     status->integrate_time_max = last_max_;
@@ -603,8 +605,7 @@ void MappingRos::Impl::onUpdateTimer(const ros::TimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!dirty_ || !have_full_) return;
     full = last_full_box_;
-    wavog::CellBox box =
-        map_.boxAround(dirty_min_x_, dirty_min_y_, dirty_max_x_, dirty_max_y_, 0);
+    wavog::CellBox box = map_.boxAround(dirty_min_x_, dirty_min_y_, dirty_max_x_, dirty_max_y_, 0);
     box.min_x = std::max(box.min_x, full.min_x);
     box.min_y = std::max(box.min_y, full.min_y);
     box.max_x = std::min(box.max_x, full.max_x);
@@ -662,10 +663,9 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
   // <stem>: the path without its extension; images go beside the map file.
   const std::size_t slash = req.path.find_last_of('/');
   const std::size_t dot = req.path.find_last_of('.');
-  const std::string stem =
-      (dot != std::string::npos && (slash == std::string::npos || dot > slash))
-          ? req.path.substr(0, dot)
-          : req.path;
+  const std::string stem = (dot != std::string::npos && (slash == std::string::npos || dot > slash))
+                               ? req.path.substr(0, dot)
+                               : req.path;
   std::vector<wavog::Raster> rasters;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -706,49 +706,53 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
 }
 
 void MappingRos::Impl::onReconfigure(wavog_mapping::MappingConfig& rc, std::uint32_t) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  wavog::MapParams next = config_.map;
-  next.policy.gamma = rc.gamma;
-  next.policy.clamp_min = rc.clamp_min;
-  next.policy.clamp_max = rc.clamp_max;
-  next.sensor.odd_occ = rc.odd_occ;
-  next.sensor.odd_emp = rc.odd_emp;
-  RosParams next_ros = config_.ros;
-  next_ros.publish_rate = rc.publish_rate;
-  std::vector<std::string> errors;
-  if (!parseScales(rc.scales, &next_ros.publish_scales)) {
-    errors.push_back("scales ('" + rc.scales + "') must be comma-separated integers");
-  }
-  for (const auto& e : next.validate()) errors.push_back(e);
-  for (const auto& e : validate(next_ros, next)) errors.push_back(e);
-  if (errors.empty()) {
-    try {
-      map_.setPolicy(next.policy, next.sensor);
-    } catch (const std::invalid_argument& e) {
-      errors.emplace_back(e.what());
+  // The timer is re-armed after the lock is released (roscpp's timer manager has locks of its own).
+  double new_period = 0.0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    wavog::MapParams next = config_.map;
+    next.policy.gamma = rc.gamma;
+    next.policy.clamp_min = rc.clamp_min;
+    next.policy.clamp_max = rc.clamp_max;
+    next.sensor.odd_occ = rc.odd_occ;
+    next.sensor.odd_emp = rc.odd_emp;
+    RosParams next_ros = config_.ros;
+    next_ros.publish_rate = rc.publish_rate;
+    std::vector<std::string> errors;
+    if (!parseScales(rc.scales, &next_ros.publish_scales)) {
+      errors.push_back("scales ('" + rc.scales + "') must be comma-separated integers");
     }
+    for (const auto& e : next.validate()) errors.push_back(e);
+    for (const auto& e : validate(next_ros, next)) errors.push_back(e);
+    if (errors.empty()) {
+      try {
+        map_.setPolicy(next.policy, next.sensor);
+      } catch (const std::invalid_argument& e) {
+        errors.emplace_back(e.what());
+      }
+    }
+    if (!errors.empty()) {
+      std::string text;
+      for (const auto& e : errors) text += "\n  " + e;
+      ROS_ERROR("%s: reconfiguration refused, keeping the previous values:%s",
+                pnh_.getNamespace().c_str(), text.c_str());
+      // Hand the previous values back to the reconfigure server (and its clients).
+      rc.gamma = config_.map.policy.gamma;
+      rc.clamp_min = config_.map.policy.clamp_min;
+      rc.clamp_max = config_.map.policy.clamp_max;
+      rc.odd_occ = config_.map.sensor.odd_occ;
+      rc.odd_emp = config_.map.sensor.odd_emp;
+      rc.publish_rate = config_.ros.publish_rate;
+      rc.scales = joinScales(config_.ros.publish_scales);
+      return;
+    }
+    if (next_ros.publish_rate != config_.ros.publish_rate) new_period = 1.0 / next_ros.publish_rate;
+    config_.map = next;
+    config_.ros.publish_rate = next_ros.publish_rate;
+    config_.ros.publish_scales = next_ros.publish_scales;
+    advertiseScalesLocked(next_ros.publish_scales);
   }
-  if (!errors.empty()) {
-    std::string text;
-    for (const auto& e : errors) text += "\n  " + e;
-    ROS_ERROR("%s: reconfiguration refused, keeping the previous values:%s",
-              pnh_.getNamespace().c_str(), text.c_str());
-    // Hand the previous values back to the reconfigure server (and its clients).
-    rc.gamma = config_.map.policy.gamma;
-    rc.clamp_min = config_.map.policy.clamp_min;
-    rc.clamp_max = config_.map.policy.clamp_max;
-    rc.odd_occ = config_.map.sensor.odd_occ;
-    rc.odd_emp = config_.map.sensor.odd_emp;
-    rc.publish_rate = config_.ros.publish_rate;
-    rc.scales = joinScales(config_.ros.publish_scales);
-    return;
-  }
-  const bool rate_changed = next_ros.publish_rate != config_.ros.publish_rate;
-  config_.map = next;
-  config_.ros.publish_rate = next_ros.publish_rate;
-  config_.ros.publish_scales = next_ros.publish_scales;
-  advertiseScalesLocked(next_ros.publish_scales);
-  if (rate_changed) publish_timer_.setPeriod(ros::Duration(1.0 / next_ros.publish_rate));
+  if (new_period > 0.0) publish_timer_.setPeriod(ros::Duration(new_period));
 }
 
 void MappingRos::Impl::diagnoseInput(const Input* in,

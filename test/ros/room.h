@@ -3,11 +3,6 @@
 #ifndef WAVOG_MAPPING_TEST_ROS_ROOM_H_
 #define WAVOG_MAPPING_TEST_ROS_ROOM_H_
 
-#include <cmath>
-#include <limits>
-#include <string>
-#include <vector>
-
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
@@ -15,6 +10,11 @@
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
 #include <tf2/LinearMath/Transform.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
 
 namespace room {
 
@@ -100,9 +100,10 @@ inline sensor_msgs::LaserScan::Ptr scanOf(const Sensor& s, const ros::Time& stam
   const tf2::Transform pose = basePose() * sensorInBase(s);
   for (int i = 0; i < kBeams; ++i) {
     const double a = scan->angle_min + i * static_cast<double>(scan->angle_increment);
-    const tf2::Vector3 d = tf2::Transform(pose.getRotation()) * tf2::Vector3(std::cos(a), std::sin(a), 0);
-    scan->ranges.push_back(static_cast<float>(
-        castRay(pose.getOrigin().x(), pose.getOrigin().y(), d.x(), d.y())));
+    const tf2::Vector3 d =
+        tf2::Transform(pose.getRotation()) * tf2::Vector3(std::cos(a), std::sin(a), 0);
+    scan->ranges.push_back(
+        static_cast<float>(castRay(pose.getOrigin().x(), pose.getOrigin().y(), d.x(), d.y())));
   }
   return scan;
 }
@@ -127,7 +128,7 @@ inline void aheadOf(const Sensor& s, double d, double* x, double* y) {
 }
 
 // Probe points (map frame).
-constexpr double kOccX = 3.95, kOccY = 0.05;    // on the wall x = +3.95
+constexpr double kOccX = 3.95, kOccY = 0.05;     // on the wall x = +3.95
 constexpr double kFreeX = 0.05, kFreeY = -1.05;  // inside the room
 constexpr double kUnkX = -6.0, kUnkY = -6.0;     // outside the room
 

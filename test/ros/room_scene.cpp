@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
   ros::Rate rate(10.0);
   while (ros::ok()) {
     const ros::Time stamp = ros::Time::now();
-    for (std::size_t i = 0; i < pubs.size(); ++i) pubs[i].publish(room::scanOf(room::sensors()[i], stamp));
+    for (std::size_t i = 0; i < pubs.size(); ++i)
+      pubs[i].publish(room::scanOf(room::sensors()[i], stamp));
     ros::spinOnce();
     rate.sleep();
   }

@@ -3,16 +3,15 @@
 // is counted by reason; the node stays up and keeps integrating; the map is unchanged where the
 // dropped scans would have changed it.
 #include <gtest/gtest.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
 
 #include <atomic>
 #include <limits>
 #include <mutex>
 #include <thread>
-
-#include <nav_msgs/OccupancyGrid.h>
-#include <ros/ros.h>
-#include <tf2_ros/static_transform_broadcaster.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include "room.h"
 #include "wavog_mapping/MapperStatus.h"
@@ -72,8 +71,7 @@ TEST(BadInput, EveryReasonCountedNodeStaysUpMapUnchanged) {
   phantomPoint(&px, &py);
   {
     const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(10);
-    while (ros::WallTime::now() < end &&
-           !(lastMap() && room::cellAt(*lastMap(), px, py) >= 0)) {
+    while (ros::WallTime::now() < end && !(lastMap() && room::cellAt(*lastMap(), px, py) >= 0)) {
       ros::WallDuration(0.05).sleep();
     }
   }
@@ -198,8 +196,8 @@ int main(int argc, char** argv) {
   std::thread tf_thread([&] {
     ros::WallRate rate(20.0);
     while (running && ros::ok()) {
-      tf.sendTransform(room::toMsg(room::sensorInBase(room::sensors()[0]), "base_link",
-                                   "moving_laser"));
+      tf.sendTransform(
+          room::toMsg(room::sensorInBase(room::sensors()[0]), "base_link", "moving_laser"));
       rate.sleep();
     }
   });

@@ -1,13 +1,12 @@
 // The one parameter loader: shipped files load and validate, default.yaml equals the compiled
 // defaults key by key, unknown keys are reported, bad values name the parameter and its range.
-#include <gtest/gtest.h>
-
 #include <dirent.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <fstream>
-#include <sstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -159,8 +158,7 @@ TEST(Config, BadValuesNameTheParameterAndItsRange) {
   EXPECT_NE(errorOf("queue_size: 2.5").find("integer"), std::string::npos);
   EXPECT_NE(errorOf("motion_compensation: 1").find("true or false"), std::string::npos);
   EXPECT_NE(errorOf("gamma: 0").find("gamma"), std::string::npos);
-  EXPECT_NE(errorOf("inputs: [{topic: a, rate: 3}]").find("unknown key 'rate'"),
-            std::string::npos);
+  EXPECT_NE(errorOf("inputs: [{topic: a, rate: 3}]").find("unknown key 'rate'"), std::string::npos);
 }
 
 TEST(Config, MissingOrMalformedFileIsAClearError) {

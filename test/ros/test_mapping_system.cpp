@@ -2,18 +2,17 @@
 // (mapping_nodelet.test): static tf, four synthetic scanners in a known room; asserts every
 // published layer's frame, resolution, size, origin, a known occupied, free and unknown cell, and
 // the status counters.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
+#include <map_msgs/OccupancyGridUpdate.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include <atomic>
 #include <map>
 #include <mutex>
 #include <thread>
-
-#include <diagnostic_msgs/DiagnosticArray.h>
-#include <map_msgs/OccupancyGridUpdate.h>
-#include <nav_msgs/OccupancyGrid.h>
-#include <ros/ros.h>
-#include <tf2_ros/static_transform_broadcaster.h>
 
 #include "room.h"
 #include "wavog_mapping/MapperStatus.h"
@@ -179,11 +178,22 @@ TEST(MappingSystem, MapUpdatesLieInsideTheFullGrid) {
 }
 
 TEST(MappingSystem, DiagnosticsPerInputAndMapper) {
+  // Early reports say "no scan received yet": wait until every input reports OK.
+  const auto ready = [](const std::map<std::string, diagnostic_msgs::DiagnosticStatus>& d) {
+    int ok = 0;
+    for (const auto& kv : d) {
+      if (kv.first.find(" input") != std::string::npos &&
+          kv.second.level == diagnostic_msgs::DiagnosticStatus::OK) {
+        ++ok;
+      }
+    }
+    return ok == 4;
+  };
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20.0);
   std::map<std::string, diagnostic_msgs::DiagnosticStatus> d;
   while (ros::ok() && ros::WallTime::now() < end) {
     d = g_recorder->diagnostics();
-    if (d.size() >= 9) break;
+    if (ready(d)) break;
     ros::WallDuration(0.05).sleep();
   }
   std::string names;
@@ -223,7 +233,9 @@ int main(int argc, char** argv) {
     subs.push_back(nh.subscribe<nav_msgs::OccupancyGrid>(
         topic, 2,
         boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
-            [topic](const nav_msgs::OccupancyGrid::ConstPtr& g) { g_recorder->onGrid(topic, g); })));
+            [topic](const nav_msgs::OccupancyGrid::ConstPtr& g) {
+              g_recorder->onGrid(topic, g);
+            })));
   }
   subs.push_back(nh.subscribe("wavog_mapping/status", 10, &Recorder::onStatus, &recorder));
   subs.push_back(nh.subscribe("map_updates", 10, &Recorder::onUpdate, &recorder));

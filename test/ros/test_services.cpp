@@ -1,22 +1,20 @@
 // Services: ~clear_region clears only its box, ~reset empties the map, ~save_map writes the native
 // file and map_server images, and a node restarted with map_file publishes the same map. A
 // corrupted map_file and a bad parameter stop the node at start-up (exit 1) with a clear message.
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
-
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <std_srvs/Empty.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include <cstdio>
 #include <fstream>
 #include <mutex>
 #include <string>
 #include <thread>
-
-#include <dynamic_reconfigure/Reconfigure.h>
-#include <nav_msgs/OccupancyGrid.h>
-#include <ros/ros.h>
-#include <std_srvs/Empty.h>
-#include <tf2_ros/static_transform_broadcaster.h>
 
 #include "room.h"
 #include "wavog_mapping/ClearRegion.h"
