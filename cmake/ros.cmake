@@ -55,6 +55,12 @@ if(CATKIN_ENABLE_TESTING)
       add_dependencies(test_bad_input ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
     endif()
 
+    # Sim time jumping backwards (bag restart): tf buffer cleared, mapping goes on.
+    add_rostest_gtest(test_clock_jump test/clock_jump.test test/ros/test_clock_jump.cpp)
+    target_include_directories(test_clock_jump SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(test_clock_jump ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_clock_jump ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+
     # Services: reset, clear_region, save_map + restart with map_file, corrupted map_file.
     if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_services.cpp)
       add_rostest_gtest(test_services test/services.test test/ros/test_services.cpp)
