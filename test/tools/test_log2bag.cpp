@@ -257,6 +257,25 @@ TEST(Log2Bag, PadHoldsTheLastPoseAndRepeatsTheStaticTransforms) {
   EXPECT_EQ(c.tf[3].transform.rotation.z, c.tf[1].transform.rotation.z);
 }
 
+TEST(Log2Bag, OdomOptionPublishesTheRawOdometry) {
+  std::string line = "FLASER 180";
+  for (int i = 0; i < 180; ++i) line += " 2.0";
+  const std::string log = writeLog("odom.log", {line + " 1 2 0.5 1 2 0.5 7.0 host 7.0",
+                                                line + " 1.5 2 0.5 4 -3 0.25 7.1 host 7.1"});
+  const std::string bag = (workDir() / "odom.bag").string();
+  const RunResult r = runLog2Bag("--odom " + log + " " + bag);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("(odom -> base_link)"), std::string::npos) << r.err;
+  const BagContent c = readBag(bag);
+  ASSERT_EQ(c.tf.size(), 2u);
+  EXPECT_EQ(c.tf[1].header.frame_id, "odom");
+  EXPECT_EQ(c.tf[1].child_frame_id, "base_link");
+  const wavog::Pose2 p = toPose(c.tf[1].transform);
+  EXPECT_DOUBLE_EQ(p.x, 4.0);
+  EXPECT_DOUBLE_EQ(p.y, -3.0);
+  EXPECT_NEAR(p.theta, 0.25, 1e-12);
+}
+
 TEST(Log2Bag, MissingInputAndBadUsage) {
   const std::string missing = (workDir() / "nope.log").string();
   RunResult r = runLog2Bag(missing + " " + (workDir() / "x.bag").string());
