@@ -21,6 +21,9 @@ $(BUILD)/CMakeCache.txt: | deps
 
 build: deps $(BUILD)/CMakeCache.txt
 	@cmake --build $(BUILD) -j$(JOBS) -- --no-print-directory
+	@# catkin's gtest / rostest executables hang off its `tests` target, outside `all`.
+	@if cmake --build $(BUILD) --target help | grep -q '\.\.\. tests$$'; then \
+	  cmake --build $(BUILD) --target tests -j$(JOBS) -- --no-print-directory; fi
 
 ## Every test (core gtests and rostests); ends with "N passed, N failed".
 test: build

@@ -9,5 +9,6 @@ if(benchmark_FOUND)
   # Smoke run in make test: builds and runs one short case so the benchmark cannot rot.
   add_test(NAME bench_core_smoke COMMAND bench_core --benchmark_filter=synthetic80m/10cm/clamp
            --benchmark_repetitions=1)
-  set_tests_properties(bench_core_smoke PROPERTIES LABELS "bench" TIMEOUT 300)
+  set_tests_properties(bench_core_smoke PROPERTIES LABELS "bench" TIMEOUT 300
+                       ENVIRONMENT WAVOG_BENCH_SCANS=50)
 endif()

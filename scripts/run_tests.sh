@@ -6,8 +6,11 @@ build=${1:?usage: run_tests.sh BUILD_DIR [ctest args]}
 shift
 export PATH=/usr/bin:$PATH
 if [ -f "$build/devel/setup.bash" ]; then
+  # ROS's env hooks read unset variables: source them without nounset.
+  set +u
   # shellcheck disable=SC1091
   source "$build/devel/setup.bash"
+  set -u
 fi
 # rostests start their own roscore on a free port; keep ROS logs inside the build tree.
 export ROS_HOME=${ROS_HOME:-$build/ros_home}

@@ -49,10 +49,13 @@ class Writer {
  public:
   template <typename T>
   void put(T v) {
-    const auto* p = reinterpret_cast<const unsigned char*>(&v);
-    buf_.insert(buf_.end(), p, p + sizeof(T));
+    bytes(&v, sizeof(T));
   }
-  void bytes(const char* p, std::size_t n) { buf_.insert(buf_.end(), p, p + n); }
+  void bytes(const void* p, std::size_t n) {
+    const std::size_t at = buf_.size();
+    buf_.resize(at + n);
+    std::memcpy(buf_.data() + at, p, n);
+  }
   std::vector<unsigned char>& buffer() { return buf_; }
 
  private:

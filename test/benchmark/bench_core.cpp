@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <random>
 #include <string>
@@ -69,7 +70,12 @@ const std::vector<Scan>& workload(const std::string& name) {
   static std::map<std::string, std::vector<Scan>> cache;
   auto it = cache.find(name);
   if (it != cache.end()) return it->second;
-  return cache[name] = name == "fr079" ? loadFr079() : synthetic80m(1000);
+  // WAVOG_BENCH_SCANS caps the scans per workload (the ctest smoke run uses it).
+  const char* cap_env = std::getenv("WAVOG_BENCH_SCANS");
+  const std::size_t cap = cap_env ? static_cast<std::size_t>(std::atol(cap_env)) : 0;
+  auto scans = name == "fr079" ? loadFr079() : synthetic80m(cap > 0 ? static_cast<int>(cap) : 1000);
+  if (cap > 0 && scans.size() > cap) scans.resize(cap);
+  return cache[name] = std::move(scans);
 }
 
 enum Variant { kClamp = 0, kForgetLazy = 1, kForgetEager = 2 };
