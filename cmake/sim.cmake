@@ -3,7 +3,8 @@
 find_package(yaml-cpp REQUIRED)
 find_package(GTest REQUIRED)
 
-add_library(wavog_sim
+# Static: the installed tools then need no extra shared library.
+add_library(wavog_sim STATIC
   src/sim/geometry.cpp src/sim/world.cpp src/sim/world_file.cpp src/sim/laser_sim.cpp
   src/sim/ground_truth.cpp)
 target_link_libraries(wavog_sim PUBLIC wavog_core PRIVATE yaml-cpp)
@@ -21,7 +22,7 @@ function(wavog_sim_test name)
 endfunction()
 
 # Policy evaluation through the core map (links wavog_core for real).
-add_library(wavog_sim_eval src/sim/evaluation.cpp)
+add_library(wavog_sim_eval STATIC src/sim/evaluation.cpp)
 target_link_libraries(wavog_sim_eval PUBLIC wavog_sim wavog_core)
 target_compile_options(wavog_sim_eval PRIVATE ${WAVOG_WARNINGS})
 
