@@ -334,7 +334,13 @@ Config configFromXmlRpc(XmlRpc::XmlRpcValue& root, std::vector<std::string>* unk
 Config loadConfig(const ros::NodeHandle& pnh, std::vector<std::string>* unknown_keys) {
   XmlRpcValue root;
   if (!pnh.getParam(pnh.getNamespace(), root)) root = XmlRpcValue();
-  return configFromXmlRpc(root, unknown_keys);
+  std::vector<std::string> unknown;
+  Config config = configFromXmlRpc(root, &unknown);
+  // dynamic_reconfigure mirrors its "scales" string into ~ (a restarted node finds it there).
+  for (const auto& key : unknown) {
+    if (key != "scales" && unknown_keys) unknown_keys->push_back(key);
+  }
+  return config;
 }
 
 XmlRpc::XmlRpcValue yamlToXmlRpc(const std::string& yaml_text) {

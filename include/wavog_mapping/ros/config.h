@@ -5,11 +5,11 @@
 #ifndef WAVOG_MAPPING_ROS_CONFIG_H_
 #define WAVOG_MAPPING_ROS_CONFIG_H_
 
-#include <string>
-#include <vector>
-
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>
+
+#include <string>
+#include <vector>
 
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -77,7 +77,8 @@ const std::vector<std::string>& knownKeys();
 /// whose message names each bad parameter, its value and its valid range.
 Config configFromXmlRpc(XmlRpc::XmlRpcValue& root, std::vector<std::string>* unknown_keys);
 
-/// Reads the private namespace of `pnh` as one struct and calls configFromXmlRpc.
+/// Reads the private namespace of `pnh` as one struct and calls configFromXmlRpc. The key
+/// "scales", which the dynamic_reconfigure server writes there, is not reported as unknown.
 Config loadConfig(const ros::NodeHandle& pnh, std::vector<std::string>* unknown_keys);
 
 /// Parses a YAML file (a map of the keys above) and calls configFromXmlRpc. Throws
