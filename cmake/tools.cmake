@@ -81,7 +81,7 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
 
     set(_wavog_playback_bag ${CMAKE_BINARY_DIR}/test_data/playback_fr079_300.bag)
     add_test(NAME tools_playback_bag
-             COMMAND sh -c "mkdir -p ${CMAKE_BINARY_DIR}/test_data && $<TARGET_FILE:wavog_log2bag> --quiet --max-scans 300 --pad 60 ${_wavog_data_dir}/fr079-corrected.log.gz ${_wavog_playback_bag}")
+             COMMAND sh -c "mkdir -p ${CMAKE_BINARY_DIR}/test_data && $<TARGET_FILE:wavog_log2bag> --quiet --max-scans 300 --pad 100 ${_wavog_data_dir}/fr079-corrected.log.gz ${_wavog_playback_bag}")
     set_tests_properties(tools_playback_bag PROPERTIES FIXTURES_SETUP wavog_playback_bag
                          LABELS "tools" TIMEOUT 60)
     # The bag's path reaches the launch file through the environment (rostest ARGS would end up

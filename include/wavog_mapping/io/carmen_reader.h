@@ -4,6 +4,7 @@
 #ifndef WAVOG_MAPPING_IO_CARMEN_READER_H_
 #define WAVOG_MAPPING_IO_CARMEN_READER_H_
 
+#include <cmath>
 #include <cstddef>
 #include <memory>
 #include <stdexcept>
@@ -32,7 +33,7 @@ struct CarmenScan {
   /// A view for WaveletMap::integrate (valid while this object lives and is unchanged).
   ScanView view(double range_min = 0.0) const;
   /// True if beam reading `r` means "no return" for this scan (r >= range_max or +inf).
-  bool isNoReturn(float r) const { return !(r < range_max) && r == r; }
+  bool isNoReturn(float r) const { return !std::isnan(r) && !(r < range_max); }
 };
 
 /// A line could not be parsed; what() is "<file>:<line>: <reason>".
