@@ -35,7 +35,7 @@ test-asan: deps
 	@cmake -S $(ROOT) -B $(BUILD_ASAN) -DCATKIN_DEVEL_PREFIX=$(BUILD_ASAN)/devel $(CMAKE_ARGS) \
 	  -DWAVOG_SANITIZE="address;undefined" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWAVOG_BUILD_ROS=OFF \
 	  >$(BUILD_ASAN)/configure.log || { cat $(BUILD_ASAN)/configure.log; exit 1; }
-	@cmake --build $(BUILD_ASAN) -j$(JOBS) -- --no-print-directory
+	@cmake --build $(BUILD_ASAN) --target core_tests -j$(JOBS) -- --no-print-directory
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  bash $(ROOT)/scripts/run_tests.sh $(BUILD_ASAN) -L core
 

@@ -10,8 +10,11 @@ target_compile_options(wavog_test_support PRIVATE ${WAVOG_WARNINGS})
 target_compile_definitions(wavog_test_support PUBLIC
   WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}" EIGEN_INITIALIZE_MATRICES_BY_NAN)
 
+# `core_tests` builds every core test (make test-asan builds only these).
+add_custom_target(core_tests)
 function(wavog_core_test name)
   add_executable(${name} test/core/${name}.cpp)
+  add_dependencies(core_tests ${name})
   target_link_libraries(${name} PRIVATE wavog_test_support GTest::Main)
   target_compile_options(${name} PRIVATE ${WAVOG_WARNINGS})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)

@@ -109,8 +109,10 @@ struct BlockKeyHash {
 };
 using BlockMap = std::unordered_map<std::uint64_t, Block, BlockKeyHash>;
 
-/// Floor division for cell -> block indices (works for negative cells).
+/// Floor division for cell -> block indices (arithmetic shift: works for negative cells).
 inline std::int64_t floorShift(std::int64_t v, int bits) { return v >> bits; }
+/// v * 2^bits for any sign (a left shift of a negative value is undefined in C++17).
+inline std::int64_t scaleUp(std::int64_t v, int bits) { return v * (std::int64_t{1} << bits); }
 
 /// Largest stored detail magnitude of a node (stored, without pending tags).
 inline float maxAbsDetail(const Node& n) {

@@ -122,7 +122,8 @@ bool WaveletMap::bounds(int scale, CellBox* box) const {
     y1 = std::max(y1, by + 1);
   }
   const int shift = impl.levels - std::clamp(scale, 0, impl.levels);
-  *box = CellBox{x0 << shift, y0 << shift, x1 << shift, y1 << shift};
+  *box = CellBox{detail::scaleUp(x0, shift), detail::scaleUp(y0, shift), detail::scaleUp(x1, shift),
+                 detail::scaleUp(y1, shift)};
   return true;
 }
 
@@ -153,8 +154,8 @@ Raster WaveletMap::exportScale(int scale, const CellBox& window, Aggregation agg
   const std::int64_t bx0 = window.min_x >> shift, bx1 = (window.max_x - 1) >> shift;
   const std::int64_t by0 = window.min_y >> shift, by1 = (window.max_y - 1) >> shift;
   const auto visit = [&](std::int64_t bx, std::int64_t by, const Block& b) {
-    writer.slot(b.has_root ? &b.root : nullptr, impl.levels, bx << impl.levels,
-                by << impl.levels, b.s, 1.0, b.known_all, b.known_any);
+    writer.slot(b.has_root ? &b.root : nullptr, impl.levels, detail::scaleUp(bx, impl.levels),
+                detail::scaleUp(by, impl.levels), b.s, 1.0, b.known_all, b.known_any);
   };
   // Look the window's blocks up, or walk the hash when the window is larger than the map.
   const double window_blocks = static_cast<double>(bx1 - bx0 + 1) * static_cast<double>(by1 - by0 + 1);

@@ -451,7 +451,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const PreparedScan& ps, Integ
   std::uint64_t visited = 0;
   for (std::int64_t by = lo_y; by <= hi_y; ++by) {
     for (std::int64_t bx = lo_x; bx <= hi_x; ++bx) {
-      const std::int64_t ix0 = bx << L, iy0 = by << L;
+      const std::int64_t ix0 = detail::scaleUp(bx, L), iy0 = detail::scaleUp(by, L);
       const CellClass cls = ps.classifyBox(L, ix0, iy0);
       ++visited;
       if (cls == CellClass::kUnknown) continue;
