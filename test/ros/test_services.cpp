@@ -1,6 +1,7 @@
 // Services: ~clear_region clears only its box, ~reset empties the map, ~save_map writes the native
 // file and map_server images, and a node restarted with map_file publishes the same map. A
 // corrupted map_file and a bad parameter stop the node at start-up (exit 1) with a clear message.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -12,6 +13,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -262,6 +264,40 @@ TEST_F(Services, DynamicReconfigureValidatesAndApplies) {
   ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", bad));
   EXPECT_EQ(value(bad.response.config, "scales"), "2,5");
   EXPECT_EQ(value(bad.response.config, "gamma"), std::to_string(0.5));
+}
+
+TEST_F(Services, SilentLaserIsReportedStale) {
+  // No scan since the suite's set-up: /diagnostics must say so (a planner must know).
+  std::mutex m;
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> d;
+  ros::NodeHandle nh;
+  auto sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10,
+      boost::function<void(const diagnostic_msgs::DiagnosticArray::ConstPtr&)>(
+          [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
+            std::lock_guard<std::mutex> lock(m);
+            for (const auto& st : a->status) d[st.name] = st;
+          }));
+  const auto find = [&](const std::string& part) {
+    std::lock_guard<std::mutex> lock(m);
+    for (const auto& kv : d) {
+      if (kv.first.find(part) != std::string::npos) return kv.second;
+    }
+    return diagnostic_msgs::DiagnosticStatus();
+  };
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(15.0);
+  while (ros::WallTime::now() < end) {
+    if (find("/scan_1 input").message.find("stale") != std::string::npos &&
+        find("/scan_1 rate").level == diagnostic_msgs::DiagnosticStatus::ERROR) {
+      break;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  const auto input = find("/scan_1 input");
+  EXPECT_EQ(input.level, diagnostic_msgs::DiagnosticStatus::WARN) << input.message;
+  EXPECT_NE(input.message.find("stale"), std::string::npos) << input.message;
+  const auto rate = find("/scan_1 rate");
+  EXPECT_EQ(rate.level, diagnostic_msgs::DiagnosticStatus::ERROR) << rate.message;
 }
 
 TEST_F(Services, CorruptedMapFileFailsAtStartUp) {
