@@ -62,13 +62,16 @@ if(CATKIN_ENABLE_TESTING)
     add_dependencies(test_clock_jump ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
 
     # Services: reset, clear_region, save_map + restart with map_file, corrupted map_file.
+    find_program(WAVOG_NODELET_BIN nodelet PATHS /usr/lib/nodelet ${nodelet_PREFIX}/lib/nodelet
+                 NO_DEFAULT_PATH)
     if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_services.cpp)
       add_rostest_gtest(test_services test/services.test test/ros/test_services.cpp)
       target_include_directories(test_services SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
       target_link_libraries(test_services ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
       add_dependencies(test_services ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
       target_compile_definitions(test_services PRIVATE
-        WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
+        WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node"
+        WAVOG_NODELET_BIN="${WAVOG_NODELET_BIN}")
     endif()
 
     # The test room as a standalone publisher (make rviz-check).

@@ -330,6 +330,17 @@ TEST_F(Services, BadParameterFailsAtStartUpNamingIt) {
   EXPECT_NE(output.find("publish_rate (-2) must be in (0, 100] Hz"), std::string::npos) << output;
 }
 
+TEST_F(Services, NodeletWithBadParameterFailsToLoadNamingIt) {
+  std::string output;
+  const int code = run("timeout 8 " + std::string(WAVOG_NODELET_BIN) +
+                           " standalone wavog_mapping/MappingNodelet __name:=badnodelet"
+                           " map:=/badnodelet/map _queue_size:=0",
+                       &output);
+  EXPECT_NE(code, 0) << output;
+  EXPECT_NE(code, 124) << "timed out instead of failing: " << output;
+  EXPECT_NE(output.find("queue_size (0) must be in [1, 1000]"), std::string::npos) << output;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
