@@ -17,6 +17,7 @@
 #include <array>
 #include <boost/make_shared.hpp>
 #include <boost/thread/recursive_mutex.hpp>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -84,7 +85,9 @@ bool parseScales(const std::string& text, std::vector<int>* scales) {
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
-    item.erase(std::remove_if(item.begin(), item.end(), ::isspace), item.end());
+    item.erase(std::remove_if(item.begin(), item.end(),
+                              [](unsigned char c) { return std::isspace(c) != 0; }),
+               item.end());
     if (item.empty()) continue;
     std::size_t used = 0;
     try {
@@ -189,39 +192,39 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
         return c;
       }()),
       map_(config_.map) {
-  const RosParams& ros = config_.ros;
-  if (!ros.map_file.empty()) {
+  const RosParams& rp = config_.ros;
+  if (!rp.map_file.empty()) {
     try {
-      map_.load(ros.map_file);
+      map_.load(rp.map_file);
     } catch (const wavog::MapIoError& e) {
-      throw std::runtime_error("map_file: cannot load '" + ros.map_file + "': " + e.what());
+      throw std::runtime_error("map_file: cannot load '" + rp.map_file + "': " + e.what());
     }
-    ROS_INFO("%s: loaded map_file '%s'", pnh_.getNamespace().c_str(), ros.map_file.c_str());
+    ROS_INFO("%s: loaded map_file '%s'", pnh_.getNamespace().c_str(), rp.map_file.c_str());
   }
 
-  buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(ros.tf_cache_time));
+  buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(rp.tf_cache_time));
   listener_ = std::make_unique<tf2_ros::TransformListener>(*buffer_, nh_, true);
 
   map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
   update_pub_ = nh_.advertise<map_msgs::OccupancyGridUpdate>("map_updates", 10);
   status_pub_ = pnh_.advertise<wavog_mapping::MapperStatus>("status", 10);
-  advertiseScalesLocked(ros.publish_scales);  // not yet shared: no lock needed
+  advertiseScalesLocked(rp.publish_scales);  // not yet shared: no lock needed
 
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
   updater_->setHardwareID("wavog_mapping");
   updater_->add("mapper",
                 [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseMapper(s); });
 
-  for (const InputConfig& ic : ros.inputs) {
+  for (const InputConfig& ic : rp.inputs) {
     auto in = std::make_unique<Input>();
     in->config = ic;
     in->topic = nh_.resolveName(ic.topic);
-    in->min_freq = ic.expected_rate * (1.0 - ros.rate_tolerance);
-    in->max_freq = ic.expected_rate * (1.0 + ros.rate_tolerance);
+    in->min_freq = ic.expected_rate * (1.0 - rp.rate_tolerance);
+    in->max_freq = ic.expected_rate * (1.0 + rp.rate_tolerance);
     Input* raw = in.get();
-    in->filter = std::make_unique<ScanFilter>(*buffer_, ros.map_frame,
-                                              static_cast<std::uint32_t>(ros.queue_size), nh_);
-    in->filter->setTolerance(ros::Duration(ros.tf_tolerance));
+    in->filter = std::make_unique<ScanFilter>(*buffer_, rp.map_frame,
+                                              static_cast<std::uint32_t>(rp.queue_size), nh_);
+    in->filter->setTolerance(ros::Duration(rp.tf_tolerance));
     in->filter->registerCallback(boost::function<void(const LaserScan::ConstPtr&)>(
         [this, raw](const LaserScan::ConstPtr& scan) { onTransformable(raw, scan); }));
     in->filter->registerFailureCallback(
@@ -264,18 +267,18 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   rc.clamp_max = config_.map.policy.clamp_max;
   rc.odd_occ = config_.map.sensor.odd_occ;
   rc.odd_emp = config_.map.sensor.odd_emp;
-  rc.publish_rate = ros.publish_rate;
-  rc.scales = joinScales(ros.publish_scales);
+  rc.publish_rate = rp.publish_rate;
+  rc.scales = joinScales(rp.publish_scales);
   reconfigure_->updateConfig(rc);
   reconfigure_->setCallback(
       [this](wavog_mapping::MappingConfig& c, std::uint32_t level) { onReconfigure(c, level); });
 
   last_status_time_ = ros::Time::now();
   publish_timer_ =
-      nh_.createTimer(ros::Duration(1.0 / ros.publish_rate), &Impl::onPublishTimer, this);
-  if (ros.update_rate > 0.0) {
+      nh_.createTimer(ros::Duration(1.0 / rp.publish_rate), &Impl::onPublishTimer, this);
+  if (rp.update_rate > 0.0) {
     update_timer_ =
-        nh_.createTimer(ros::Duration(1.0 / ros.update_rate), &Impl::onUpdateTimer, this);
+        nh_.createTimer(ros::Duration(1.0 / rp.update_rate), &Impl::onUpdateTimer, this);
   }
   diag_timer_ =
       nh_.createTimer(ros::Duration(0.5), [this](const ros::TimerEvent&) { updater_->update(); });
@@ -283,8 +286,8 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   std::string topics;
   for (const auto& in : inputs_) topics += " " + in->topic;
   ROS_INFO("%s: mapping%s into '%s' (policy %s, resolution %g m), publishing at %g Hz",
-           pnh_.getNamespace().c_str(), topics.c_str(), ros.map_frame.c_str(),
-           wavog::toString(config_.map.policy.type), config_.map.grid.resolution, ros.publish_rate);
+           pnh_.getNamespace().c_str(), topics.c_str(), rp.map_frame.c_str(),
+           wavog::toString(config_.map.policy.type), config_.map.grid.resolution, rp.publish_rate);
 }
 
 MappingRos::Impl::~Impl() {
@@ -483,22 +486,22 @@ void MappingRos::Impl::markAllDirtyLocked() {
 void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
   const auto t_start = Clock::now();
   const ros::Time now = ros::Time::now();
-  const RosParams& ros = config_.ros;
+  const RosParams& rp = config_.ros;
 
   // Window centre: the robot, from tf (latest), outside the lock.
-  bool windowed = ros.publish_window > 0.0;
+  bool windowed = rp.publish_window > 0.0;
   double cx = 0.0, cy = 0.0;
   bool window_ok = true;
   if (windowed) {
     try {
-      const auto t = buffer_->lookupTransform(ros.map_frame, ros.base_frame, ros::Time(0));
+      const auto t = buffer_->lookupTransform(rp.map_frame, rp.base_frame, ros::Time(0));
       cx = t.transform.translation.x;
       cy = t.transform.translation.y;
     } catch (const tf2::TransformException& e) {
       window_ok = false;
       ROS_WARN_THROTTLE(kWarnPeriod,
                         "%s: no pose of '%s' for publish_window, maps not published: %s",
-                        pnh_.getNamespace().c_str(), ros.base_frame.c_str(), e.what());
+                        pnh_.getNamespace().c_str(), rp.base_frame.c_str(), e.what());
     }
   }
 
@@ -523,7 +526,7 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
       wavog::CellBox box;
       bool have = true;
       if (windowed) {
-        const double w = ros.publish_window;
+        const double w = rp.publish_window;
         box = map_.boxAround(cx - w, cy - w, cx + w, cy + w, job.scale);
       } else {
         have = map_.bounds(job.scale, &box);
@@ -531,7 +534,7 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
       job.raster =
           have && !box.empty()
               ? map_.exportScale(job.scale, box,
-                                 job.scale == 0 ? wavog::Aggregation::kMean : ros.scale_aggregation)
+                                 job.scale == 0 ? wavog::Aggregation::kMean : rp.scale_aggregation)
               : emptyRaster(job.scale, map_.resolution());
       if (job.scale == 0) {
         // The dirty region is reset by map_updates only: re-sending an area the full map already
@@ -545,7 +548,7 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
     const double period = (now - last_status_time_).toSec();
     last_status_time_ = now;
     status->header.stamp = now;
-    status->header.frame_id = ros.map_frame;
+    status->header.frame_id = rp.map_frame;
     for (const auto& in : inputs_) {
       InputCounters& c = in->c;
       c.rate = period > 0.0 ? static_cast<double>(c.received_in_period) / period : 0.0;
@@ -589,7 +592,7 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
     status->bytes = ms.bytes;
   }
 
-  for (const Job& job : jobs) job.pub.publish(toOccupancyGridMsg(job.raster, ros.map_frame, now));
+  for (const Job& job : jobs) job.pub.publish(toOccupancyGridMsg(job.raster, rp.map_frame, now));
   status_pub_.publish(status);
   const double elapsed = std::chrono::duration<double>(Clock::now() - t_start).count();
   std::lock_guard<std::mutex> lock(mutex_);
