@@ -78,7 +78,8 @@ ScanView MotionCompensator::compensate(const ScanView& scan, const Pose2& start,
       value = static_cast<float>(std::hypot(rx, ry));
       // Moving into the sensor's blind zone or out of its range changes the reading's class;
       // keep it a return only when it still is one.
-      rank = (static_cast<double>(value) >= scan.range_min && static_cast<double>(value) < scan.range_max)
+      rank = (static_cast<double>(value) >= scan.range_min &&
+              static_cast<double>(value) < scan.range_max)
                  ? kReturn
                  : kInvalid;
       if (rank == kInvalid) value = std::numeric_limits<float>::quiet_NaN();

@@ -1,7 +1,7 @@
-// Motion compensation of one planar sweep (and the reach of a scan): beams measured while the sensor moved are re-expressed
-// in one reference pose and re-binned onto the scan's angular grid, so that the result can go to
-// WaveletMap::integrate(reference, view). Map frame, metres, radians. Not thread-safe (one
-// compensator per thread; it reuses its buffer).
+// Motion compensation of one planar sweep (and the reach of a scan): beams measured while the
+// sensor moved are re-expressed in one reference pose and re-binned onto the scan's angular grid,
+// so that the result can go to WaveletMap::integrate(reference, view). Map frame, metres, radians.
+// Not thread-safe (one compensator per thread; it reuses its buffer).
 #ifndef WAVOG_MAPPING_CORE_MOTION_COMPENSATION_H_
 #define WAVOG_MAPPING_CORE_MOTION_COMPENSATION_H_
 

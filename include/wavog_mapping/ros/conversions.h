@@ -3,13 +3,13 @@
 #ifndef WAVOG_MAPPING_ROS_CONVERSIONS_H_
 #define WAVOG_MAPPING_ROS_CONVERSIONS_H_
 
-#include <cstddef>
-#include <string>
-
 #include <geometry_msgs/Transform.h>
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/LaserScan.h>
+
+#include <cstddef>
+#include <string>
 
 #include "wavog_mapping/core/types.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -18,14 +18,14 @@ namespace wavog_ros {
 
 /// Why a whole scan was dropped. Order = counter order in msg/InputStatus.msg.
 enum class DropReason {
-  kEmpty,           ///< no beams
-  kSizeMismatch,    ///< ranges size disagrees with angle_min, angle_max, angle_increment
-  kBadAngles,       ///< angle_increment zero or non-finite, or non-finite angle limits
-  kBadFrame,        ///< empty frame_id or a leading '/'
-  kTfUnavailable,   ///< unknown frame, or tf did not arrive before the queue overflowed
-  kTfTooOld,        ///< stamp older than the tf buffer
-  kNoValidBeam,     ///< every beam invalid (REP 117): nothing to integrate
-  kBadGeometry,     ///< refused by the core (bad range limits, non-finite pose, ...)
+  kEmpty,          ///< no beams
+  kSizeMismatch,   ///< ranges size disagrees with angle_min, angle_max, angle_increment
+  kBadAngles,      ///< angle_increment zero or non-finite, or non-finite angle limits
+  kBadFrame,       ///< empty frame_id or a leading '/'
+  kTfUnavailable,  ///< unknown frame, or tf did not arrive before the queue overflowed
+  kTfTooOld,       ///< stamp older than the tf buffer
+  kNoValidBeam,    ///< every beam invalid (REP 117): nothing to integrate
+  kBadGeometry,    ///< refused by the core (bad range limits, non-finite pose, ...)
 };
 constexpr std::size_t kNumDropReasons = 8;
 
@@ -41,8 +41,8 @@ bool checkScan(const sensor_msgs::LaserScan& scan, DropReason* reason);
 wavog::ScanView toScanView(const sensor_msgs::LaserScan& scan);
 
 /// Planar pose (map frame) of a sensor from its 3D transform map <- sensor. A sensor mounted upside
-/// down (its z axis pointing down) sees the plane mirrored: *mirrored is set and the scan's view must
-/// go through mirrorView().
+/// down (its z axis pointing down) sees the plane mirrored: *mirrored is set and the scan's view
+/// must go through mirrorView().
 wavog::Pose2 toPose2(const geometry_msgs::Transform& transform, bool* mirrored);
 
 /// Mirrors a view's bearings (angle_min and angle_increment change sign).

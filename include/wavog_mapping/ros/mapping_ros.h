@@ -7,9 +7,9 @@
 #ifndef WAVOG_MAPPING_ROS_MAPPING_ROS_H_
 #define WAVOG_MAPPING_ROS_MAPPING_ROS_H_
 
-#include <memory>
-
 #include <ros/node_handle.h>
+
+#include <memory>
 
 namespace wavog_ros {
 
