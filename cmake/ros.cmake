@@ -61,6 +61,12 @@ if(CATKIN_ENABLE_TESTING)
     target_link_libraries(test_clock_jump ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
     add_dependencies(test_clock_jump ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
 
+    # Motion compensation through ROS: a moving scanner, compensation on and off.
+    add_rostest_gtest(test_motion test/motion.test test/ros/test_motion.cpp)
+    target_include_directories(test_motion SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(test_motion ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_motion ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+
     # Services: reset, clear_region, save_map + restart with map_file, corrupted map_file.
     find_program(WAVOG_NODELET_BIN nodelet PATHS /usr/lib/nodelet ${nodelet_PREFIX}/lib/nodelet
                  NO_DEFAULT_PATH)
