@@ -61,6 +61,12 @@ int run(const std::string& command, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+/// Asks a node started by run() to shut down (it would otherwise run until its timeout).
+void stopNode(const std::string& name) {
+  std::string ignored;
+  run("rosnode kill " + name, &ignored);
+}
+
 const std::string kDir = "/tmp/wavog_test_services_" + std::to_string(getpid());
 const std::string kMapFile = kDir + "/room.wavog";
 
@@ -94,14 +100,15 @@ TEST_F(Services, SaveMapWritesNativeAndMapServerFiles) {
 
   // A node restarted with map_file publishes the same map (same geometry, same values).
   std::string output;
-  const std::string cmd = std::string("timeout 5 ") + WAVOG_NODE_BIN +
+  const std::string cmd = std::string("timeout 20 ") + WAVOG_NODE_BIN +
                           " __name:=restored map:=/restored/map scan_1:=/restored/scan" +
                           " _map_file:=" + kMapFile;
   ros::param::set("/restored/resolution", 0.1);
   ros::param::set("/restored/block_levels", 6);
   std::thread restored([&] { run(cmd, &output); });
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(8.0);
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20.0);
   while (ros::WallTime::now() < end && !get(g_restored)) ros::WallDuration(0.05).sleep();
+  stopNode("/restored");
   restored.join();
   const auto again = get(g_restored);
   ASSERT_TRUE(again) << output;
@@ -180,11 +187,11 @@ TEST_F(Services, PublishWindowLimitsTheGrid) {
           }));
   std::string output;
   std::thread node([&] {
-    run(std::string("timeout 5 ") + WAVOG_NODE_BIN +
+    run(std::string("timeout 20 ") + WAVOG_NODE_BIN +
             " __name:=window map:=/window/map scan:=/window/scan",
         &output);
   });
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(5.0);
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20.0);
   while (ros::WallTime::now() < end) {
     {
       std::lock_guard<std::mutex> lock(m);
@@ -192,6 +199,7 @@ TEST_F(Services, PublishWindowLimitsTheGrid) {
     }
     ros::WallDuration(0.05).sleep();
   }
+  stopNode("/window");
   node.join();
   std::lock_guard<std::mutex> lock(m);
   ASSERT_TRUE(window) << output;
