@@ -65,13 +65,18 @@ class NodePool {
   NodeGroup& group(std::uint32_t g) { return chunks_[g >> kChunkBits][g & kChunkMask]; }
   const NodeGroup& group(std::uint32_t g) const { return chunks_[g >> kChunkBits][g & kChunkMask]; }
   std::size_t liveGroups() const { return live_; }
-  std::size_t bytes() const {
-    return live_ * sizeof(NodeGroup) + free_.capacity() * sizeof(std::uint32_t) +
-           chunks_.capacity() * sizeof(void*);
+  /// Bytes of the live groups plus bookkeeping.
+  std::size_t bytes() const { return live_ * sizeof(NodeGroup) + overhead(); }
+  /// Bytes of every allocated chunk plus bookkeeping.
+  std::size_t bytesReserved() const {
+    return chunks_.size() * (std::size_t{1} << kChunkBits) * sizeof(NodeGroup) + overhead();
   }
 
  private:
-  static constexpr std::uint32_t kChunkBits = 12;
+  std::size_t overhead() const {
+    return free_.capacity() * sizeof(std::uint32_t) + chunks_.capacity() * sizeof(void*);
+  }
+  static constexpr std::uint32_t kChunkBits = 8;  // 256 groups (20 KiB) per chunk
   static constexpr std::uint32_t kChunkMask = (1u << kChunkBits) - 1;
   void addChunk() { chunks_.emplace_back(new NodeGroup[std::size_t{1} << kChunkBits]); }
   std::vector<std::unique_ptr<NodeGroup[]>> chunks_;

@@ -177,10 +177,14 @@ void printSummary() {
     for (std::size_t i = 0; i < r.log_odds.size(); ++i) {
       max_err = std::max(max_err, static_cast<double>(std::fabs(r.log_odds[i] - ref.log_odds[i])));
     }
-    std::printf("tau %.2f: %zu nodes, %zu bytes, %llu observed cells, %.3f bytes/cell (target <= 1 "
-                "at tau 0), max |error| vs tau 0: %.4f log-odds\n",
-                tau, st.nodes, st.bytes, static_cast<unsigned long long>(st.observed_cells),
-                static_cast<double>(st.bytes) / static_cast<double>(st.observed_cells), max_err);
+    std::printf("tau %.2f: %zu nodes, %zu bytes (%zu reserved), %llu observed cells, %.3f "
+                "bytes/cell (%.3f reserved; target <= 1 at tau 0), max |error| vs tau 0: %.4f "
+                "log-odds\n",
+                tau, st.nodes, st.bytes, st.bytes_reserved,
+                static_cast<unsigned long long>(st.observed_cells),
+                static_cast<double>(st.bytes) / static_cast<double>(st.observed_cells),
+                static_cast<double>(st.bytes_reserved) / static_cast<double>(st.observed_cells),
+                max_err);
   }
 }
 

@@ -222,6 +222,7 @@ TEST(Readout, GrowsInEveryDirection) {
   const auto st = map.stats(true);
   EXPECT_GT(st.observed_cells, 4u * 1000u);
   EXPECT_GT(st.bytes, 0u);
+  EXPECT_GE(st.bytes_reserved, st.bytes);
 }
 
 }  // namespace

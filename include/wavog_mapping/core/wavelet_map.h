@@ -32,7 +32,9 @@ struct IntegrateStats {
 struct MapStats {
   std::size_t blocks = 0;           ///< hashed blocks
   std::size_t nodes = 0;            ///< live quadtree nodes (each holds 3 details)
-  std::size_t bytes = 0;            ///< bytes held by blocks, nodes (allocated groups) and the hash
+  std::size_t bytes = 0;            ///< bytes used: blocks, live node groups and the hash
+  std::size_t bytes_reserved = 0;   ///< bytes allocated: as `bytes`, but with every pool chunk
+                                    ///< ever allocated (the high-water mark; chunks are not freed)
   std::uint64_t nodes_visited_last = 0;  ///< nodes visited by the last integrate()
   std::uint64_t observed_cells = 0;      ///< finest cells ever observed (only if requested)
 };
