@@ -11,7 +11,7 @@
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
-#include <tf2_ros/transform_listener.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <algorithm>
 #include <array>
@@ -143,7 +143,14 @@ struct MappingRos::Impl {
 
   // tf first: the filters (in inputs_) refer to the buffer and are destroyed before it.
   std::unique_ptr<tf2_ros::Buffer> buffer_;
-  std::unique_ptr<tf2_ros::TransformListener> listener_;
+  /// Our own /tf and /tf_static subscribers instead of tf2_ros::TransformListener: Debian's
+  /// tf2_ros (0.7.6) MessageFilter::add() registers its transformable request before queueing the
+  /// message, so a transform inserted by another thread in between notifies nobody and the scan
+  /// waits in the filter forever (seen in fast bag playback: a few scans of 300 never processed).
+  /// tf_mutex_ serialises tf insertion with MessageFilter::add() and buffer clearing.
+  std::mutex tf_mutex_;
+  ros::Subscriber tf_sub_, tf_static_sub_;
+  void onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static);
 
   /// The one lock: map_, compensator_, every Input::c, the statistics, the dirty box, the scale
   /// publishers and config_. Never held while publishing or while waiting on tf.
@@ -203,7 +210,17 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   }
 
   buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(rp.tf_cache_time));
-  listener_ = std::make_unique<tf2_ros::TransformListener>(*buffer_, nh_, true);
+  ros::NodeHandle root;
+  tf_sub_ = root.subscribe<tf2_msgs::TFMessage>(
+      "/tf", 100,
+      boost::function<void(const tf2_msgs::TFMessage::ConstPtr&)>(
+          [this](const tf2_msgs::TFMessage::ConstPtr& m) { onTf(m, false); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  tf_static_sub_ = root.subscribe<tf2_msgs::TFMessage>(
+      "/tf_static", 100,
+      boost::function<void(const tf2_msgs::TFMessage::ConstPtr&)>(
+          [this](const tf2_msgs::TFMessage::ConstPtr& m) { onTf(m, true); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
 
   map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
   update_pub_ = nh_.advertise<map_msgs::OccupancyGridUpdate>("map_updates", 10);
@@ -294,6 +311,8 @@ MappingRos::Impl::~Impl() {
   publish_timer_.stop();
   update_timer_.stop();
   diag_timer_.stop();
+  tf_sub_.shutdown();
+  tf_static_sub_.shutdown();
   for (auto& in : inputs_) in->sub.shutdown();
   reconfigure_.reset();
   inputs_.clear();  // filters before the buffer
@@ -352,11 +371,24 @@ void MappingRos::Impl::onScan(Input* in, const LaserScan::ConstPtr& scan) {
       return;
     }
   }
+  std::lock_guard<std::mutex> tf_lock(tf_mutex_);
   if (clear_tf) {
     ROS_WARN("%s: clock jumped backwards: tf buffer cleared", pnh_.getNamespace().c_str());
     buffer_->clear();
   }
   in->filter->add(scan);
+}
+
+void MappingRos::Impl::onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static) {
+  std::lock_guard<std::mutex> tf_lock(tf_mutex_);
+  for (const auto& t : msg->transforms) {
+    try {
+      buffer_->setTransform(t, "default_authority", is_static);
+    } catch (const tf2::TransformException& e) {
+      ROS_WARN_THROTTLE(kWarnPeriod, "%s: transform refused by the tf buffer: %s",
+                        pnh_.getNamespace().c_str(), e.what());
+    }
+  }
 }
 
 void MappingRos::Impl::onFilterFailure(
