@@ -119,6 +119,11 @@ inline std::int64_t floorShift(std::int64_t v, int bits) { return v >> bits; }
 /// v * 2^bits for any sign (a left shift of a negative value is undefined in C++17).
 inline std::int64_t scaleUp(std::int64_t v, int bits) { return v * (std::int64_t{1} << bits); }
 
+/// Sets or clears `bit` in a knowledge mask.
+inline void setBit(std::uint8_t* mask, std::uint8_t bit, bool on) {
+  *mask = static_cast<std::uint8_t>(on ? (*mask | bit) : (*mask & ~bit));
+}
+
 /// Largest stored detail magnitude of a node (stored, without pending tags).
 inline float maxAbsDetail(const Node& n) {
   return std::fmax(std::fabs(n.d[0]), std::fmax(std::fabs(n.d[1]), std::fabs(n.d[2])));
@@ -156,6 +161,18 @@ struct WaveletMap::Impl {
   detail::Node& installChild(detail::Node& n, int q, const detail::Node& m);
   /// Removes child q of `n` and its whole subtree.
   void removeChild(detail::Node& n, int q);
+  /// Stores `m` as the root node of block `b`.
+  void installRoot(detail::Block* b, const detail::Node& m) {
+    b->root = m;
+    b->has_root = true;
+    ++nodes;
+  }
+  /// Deletes the root node of block `b` and its subtree (the block becomes uniform).
+  void removeRoot(detail::Block* b) {
+    freeSubtree(b->root);
+    b->has_root = false;
+    --nodes;
+  }
   /// Frees every node below `n` (not n itself).
   void freeSubtree(detail::Node& n);
 
@@ -171,6 +188,28 @@ struct WaveletMap::Impl {
   bool isTrivial(const detail::Node& n) const {
     return n.child_mask == 0 && detail::maxAbsDetail(n) <= prune_threshold &&
            (n.known_any == 0 || n.known_all == 0xF);
+  }
+
+  /// A temporary node standing for a missing child (a uniform block) about to be refined.
+  static detail::Node uniformSlot(bool all, bool any) {
+    detail::Node n;
+    n.known_all = all ? 0xF : 0;
+    n.known_any = any ? 0xF : 0;
+    return n;
+  }
+  /// After slot node `m` was updated (the stored child when `existed`, else a temporary from
+  /// uniformSlot): reports the slot's knowledge, deletes a stored node that became trivial and
+  /// stores a temporary that did not. install(m) stores a node, remove() deletes the stored one.
+  template <typename Install, typename Remove>
+  void settleSlot(const detail::Node& m, bool existed, bool* all, bool* any, Install install,
+                  Remove remove) {
+    *all = m.known_all == 0xF;
+    *any = m.known_any != 0;
+    if (isTrivial(m)) {
+      if (existed) remove();
+    } else if (!existed) {
+      install(m);
+    }
   }
 
   /// Block lookup (nullptr when absent) and creation (uniform at the prior, unobserved).

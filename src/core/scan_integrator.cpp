@@ -303,16 +303,7 @@ class Integrator {
     bool all = b.known_all, any = b.known_any;
     b.s += processSlot(
         root, cls, L, ix0, iy0, b.s, &all, &any,
-        [&](const Node& m) {
-          b.root = m;
-          b.has_root = true;
-          ++impl_.nodes;
-        },
-        [&]() {
-          impl_.freeSubtree(b.root);
-          b.has_root = false;
-          --impl_.nodes;
-        });
+        [&](const Node& m) { impl_.installRoot(&b, m); }, [&]() { impl_.removeRoot(&b); });
     b.known_all = all;
     b.known_any = any;
   }
@@ -357,20 +348,10 @@ class Integrator {
       default:
         break;
     }
-    Node tmp;
-    if (node == nullptr) {
-      tmp.known_all = *all ? 0xF : 0;
-      tmp.known_any = *any ? 0xF : 0;
-    }
+    Node tmp = WaveletMap::Impl::uniformSlot(*all, *any);
     Node& m = node ? *node : tmp;
     const double ds = visitNode(m, l, ix0, iy0, s);
-    *all = m.known_all == 0xF;
-    *any = m.known_any != 0;
-    if (impl_.isTrivial(m)) {
-      if (node) remove();
-    } else if (!node) {
-      install(m);
-    }
+    impl_.settleSlot(m, node != nullptr, all, any, install, remove);
     return ds;
   }
 
@@ -402,8 +383,8 @@ class Integrator {
       delta[qu] = processSlot(
           ch, cls, l - 1, cx, cy, c[qu], &all, &any,
           [&](const Node& m) { impl_.installChild(n, q, m); }, [&]() { impl_.removeChild(n, q); });
-      n.known_all = static_cast<std::uint8_t>(all ? (n.known_all | bit) : (n.known_all & ~bit));
-      n.known_any = static_cast<std::uint8_t>(any ? (n.known_any | bit) : (n.known_any & ~bit));
+      detail::setBit(&n.known_all, bit, all);
+      detail::setBit(&n.known_any, bit, any);
     }
     haar::Details<double> dd;
     const double ds = haar::forward(delta, &dd);

@@ -228,27 +228,21 @@ double clearNode(WaveletMap::Impl& impl, Node& n, int l, std::int64_t ix0, std::
     if (inside || l == 1) {
       if (l > 1 && impl.hasChild(n, q)) impl.removeChild(n, q);
       delta[static_cast<std::size_t>(q)] = impl.init - c[static_cast<std::size_t>(q)];
-      n.known_all = static_cast<std::uint8_t>(n.known_all & ~bit);
-      n.known_any = static_cast<std::uint8_t>(n.known_any & ~bit);
+      detail::setBit(&n.known_all, bit, false);
+      detail::setBit(&n.known_any, bit, false);
       continue;
     }
-    Node tmp;
     const bool existed = impl.hasChild(n, q);
-    if (!existed) {
-      tmp.known_all = (n.known_all & bit) ? 0xF : 0;
-      tmp.known_any = (n.known_any & bit) ? 0xF : 0;
-    }
+    Node tmp = WaveletMap::Impl::uniformSlot((n.known_all & bit) != 0, (n.known_any & bit) != 0);
     Node& m = existed ? impl.child(n, q) : tmp;
     delta[static_cast<std::size_t>(q)] =
         clearNode(impl, m, l - 1, cx, cy, c[static_cast<std::size_t>(q)], box);
-    const bool all = m.known_all == 0xF, any = m.known_any != 0;
-    if (impl.isTrivial(m)) {
-      if (existed) impl.removeChild(n, q);
-    } else if (!existed) {
-      impl.installChild(n, q, m);
-    }
-    n.known_all = static_cast<std::uint8_t>(all ? (n.known_all | bit) : (n.known_all & ~bit));
-    n.known_any = static_cast<std::uint8_t>(any ? (n.known_any | bit) : (n.known_any & ~bit));
+    bool all = false, any = false;
+    impl.settleSlot(
+        m, existed, &all, &any, [&](const Node& kept) { impl.installChild(n, q, kept); },
+        [&]() { impl.removeChild(n, q); });
+    detail::setBit(&n.known_all, bit, all);
+    detail::setBit(&n.known_any, bit, any);
   }
   haar::Details<double> dd;
   const double ds = haar::forward(delta, &dd);
@@ -284,33 +278,16 @@ void WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y
     const bool inside = x0 >= box.x0 && x0 + size - 1 <= box.x1 && y0 >= box.y0 &&
                         y0 + size - 1 <= box.y1;
     if (inside) {
-      if (b.has_root) {
-        impl.freeSubtree(b.root);
-        --impl.nodes;
-      }
+      if (b.has_root) impl.removeRoot(&b);
       impl.blocks.erase(key);
       continue;
     }
-    Node tmp;
-    if (!b.has_root) {
-      tmp.known_all = b.known_all ? 0xF : 0;
-      tmp.known_any = b.known_any ? 0xF : 0;
-    }
+    Node tmp = WaveletMap::Impl::uniformSlot(b.known_all, b.known_any);
     Node& m = b.has_root ? b.root : tmp;
     b.s += clearNode(impl, m, L, x0, y0, b.s, box);
-    b.known_all = m.known_all == 0xF;
-    b.known_any = m.known_any != 0;
-    if (impl.isTrivial(m)) {
-      if (b.has_root) {
-        impl.freeSubtree(b.root);
-        --impl.nodes;
-      }
-      b.has_root = false;
-    } else if (!b.has_root) {
-      b.root = m;
-      b.has_root = true;
-      ++impl.nodes;
-    }
+    impl.settleSlot(m, b.has_root, &b.known_all, &b.known_any,
+                    [&](const Node& kept) { impl.installRoot(&b, kept); },
+                    [&]() { impl.removeRoot(&b); });
     impl.dropIfEmpty(bx, by);
   }
 }

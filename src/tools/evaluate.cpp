@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "plot.h"
+#include "tool_support.h"
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/sim/evaluation.h"
 #include "wavog_mapping/sim/laser_sim.h"
@@ -27,6 +28,8 @@
 #include "wavog_mapping/sim/world_file.h"
 
 namespace {
+
+using wavog_tools::parseNumber;
 
 using wavog::Image;
 using wavog::Rgb;
@@ -61,16 +64,6 @@ void usage(std::ostream& out) {
          "  --core-maps DIR       also map the scenario with the default parameters (forgetting,\n"
          "                        5 cm) through the core and write map_s<scale>.png/.pgm/.yaml\n"
          "                        for scales 0, 2, 3, 4 there (when wavog_offline is missing)\n";
-}
-
-double parseNumber(const std::string& flag, const char* text) {
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text, &end);
-  if (errno || end == text || *end || !std::isfinite(v)) {
-    throw std::invalid_argument(flag + ": not a number: '" + text + "'");
-  }
-  return v;
 }
 
 Options parseArgs(int argc, char** argv) {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "tool_support.h"
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/sim/ground_truth.h"
 #include "wavog_mapping/sim/laser_sim.h"
@@ -27,6 +28,8 @@
 #include "wavog_mapping/sim/world_file.h"
 
 namespace {
+
+using wavog_tools::parseNumber;
 
 using wavog::sim::GridWindow;
 using wavog::sim::LaserParams;
@@ -68,16 +71,6 @@ void usage(std::ostream& out) {
          "  --truth-resolution R  ground-truth cell size (m, default 0.1)\n"
          "  --truth-every S       ground-truth snapshot period (s, default 10)\n"
          "  --write-world FILE    write the world as YAML (e.g. to edit the default) and go on\n";
-}
-
-double parseNumber(const std::string& flag, const char* text) {
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text, &end);
-  if (errno || end == text || *end || !std::isfinite(v)) {
-    throw std::invalid_argument(flag + ": not a number: '" + text + "'");
-  }
-  return v;
 }
 
 Options parseArgs(int argc, char** argv) {

@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -246,6 +248,16 @@ std::vector<std::string> splitList(const std::string& text) {
 
 std::string stripSlash(const std::string& frame) {
   return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
+}
+
+double parseNumber(const std::string& flag, const char* text) {
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text, &end);
+  if (errno || end == text || *end || !std::isfinite(v)) {
+    throw std::invalid_argument(flag + ": not a number: '" + text + "'");
+  }
+  return v;
 }
 
 }  // namespace wavog_tools

@@ -121,6 +121,10 @@ std::vector<std::string> splitList(const std::string& text);
 /// Strips one leading '/' (tf2 rejects frame ids that start with one).
 std::string stripSlash(const std::string& frame);
 
+/// A command-line number: the whole of `text` must be a finite number, else
+/// std::invalid_argument("<flag>: not a number: '<text>'").
+double parseNumber(const std::string& flag, const char* text);
+
 }  // namespace wavog_tools
 
 #endif  // WAVOG_MAPPING_TOOLS_TOOL_SUPPORT_H_

@@ -12,7 +12,9 @@
 #include <tf2/LinearMath/Transform.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -131,6 +133,18 @@ inline void aheadOf(const Sensor& s, double d, double* x, double* y) {
 constexpr double kOccX = 3.95, kOccY = 0.05;     // on the wall x = +3.95
 constexpr double kFreeX = 0.05, kFreeY = -1.05;  // inside the room
 constexpr double kUnkX = -6.0, kUnkY = -6.0;     // outside the room
+
+/// Subscribes to `topic` and keeps its latest message in *latest, written under *mutex.
+template <typename M>
+ros::Subscriber keepLatest(ros::NodeHandle& nh, const std::string& topic, std::uint32_t queue,
+                           std::mutex* mutex, boost::shared_ptr<const M>* latest) {
+  return nh.subscribe<M>(topic, queue,
+                         boost::function<void(const boost::shared_ptr<const M>&)>(
+                             [mutex, latest](const boost::shared_ptr<const M>& m) {
+                               std::lock_guard<std::mutex> lock(*mutex);
+                               *latest = m;
+                             }));
+}
 
 }  // namespace room
 

@@ -202,20 +202,9 @@ int main(int argc, char** argv) {
     }
   });
   g_scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 50);
-  auto map_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
-      "map", 2,
-      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
-          [](const nav_msgs::OccupancyGrid::ConstPtr& g) {
-            std::lock_guard<std::mutex> lock(g_mutex);
-            g_map = g;
-          }));
-  auto status_sub = nh.subscribe<wavog_mapping::MapperStatus>(
-      "wavog_mapping/status", 10,
-      boost::function<void(const wavog_mapping::MapperStatus::ConstPtr&)>(
-          [](const wavog_mapping::MapperStatus::ConstPtr& s) {
-            std::lock_guard<std::mutex> lock(g_mutex);
-            g_status = s;
-          }));
+  auto map_sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map", 2, &g_mutex, &g_map);
+  auto status_sub = room::keepLatest<wavog_mapping::MapperStatus>(nh, "wavog_mapping/status", 10,
+                                                                  &g_mutex, &g_status);
   ros::AsyncSpinner spinner(2);
   spinner.start();
   // Let the node subscribe before the first scan.

@@ -80,13 +80,8 @@ int main(int argc, char** argv) {
   ros::WallDuration(0.5).sleep();  // sim time known before tf is stamped
   tf2_ros::StaticTransformBroadcaster static_tf;
   static_tf.sendTransform(room::staticTree());
-  auto sub = nh.subscribe<wavog_mapping::MapperStatus>(
-      "wavog_mapping/status", 10,
-      boost::function<void(const wavog_mapping::MapperStatus::ConstPtr&)>(
-          [](const wavog_mapping::MapperStatus::ConstPtr& s) {
-            std::lock_guard<std::mutex> lock(g_mutex);
-            g_status = s;
-          }));
+  auto sub = room::keepLatest<wavog_mapping::MapperStatus>(nh, "wavog_mapping/status", 10, &g_mutex,
+                                                           &g_status);
   ros::AsyncSpinner spinner(2);
   spinner.start();
   const int result = RUN_ALL_TESTS();

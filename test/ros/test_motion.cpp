@@ -86,27 +86,10 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   auto clock_pub = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   auto scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 20);
-  auto map_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
-      "map", 2,
-      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
-          [](const nav_msgs::OccupancyGrid::ConstPtr& g) {
-            std::lock_guard<std::mutex> lock(g_mutex);
-            g_map = g;
-          }));
-  auto raw_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
-      "map_raw", 2,
-      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
-          [](const nav_msgs::OccupancyGrid::ConstPtr& g) {
-            std::lock_guard<std::mutex> lock(g_mutex);
-            g_raw = g;
-          }));
-  auto status_sub = nh.subscribe<wavog_mapping::MapperStatus>(
-      "wavog_mapping/status", 10,
-      boost::function<void(const wavog_mapping::MapperStatus::ConstPtr&)>(
-          [](const wavog_mapping::MapperStatus::ConstPtr& s) {
-            std::lock_guard<std::mutex> lock(g_mutex);
-            g_status = s;
-          }));
+  auto map_sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map", 2, &g_mutex, &g_map);
+  auto raw_sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map_raw", 2, &g_mutex, &g_raw);
+  auto status_sub = room::keepLatest<wavog_mapping::MapperStatus>(nh, "wavog_mapping/status", 10,
+                                                                  &g_mutex, &g_status);
   ros::AsyncSpinner spinner(2);
   spinner.start();
   // Wait for both mappers to subscribe before sim time starts moving.

@@ -242,13 +242,7 @@ TEST_F(Services, DynamicReconfigureValidatesAndApplies) {
   nav_msgs::OccupancyGrid::ConstPtr g5;
   std::mutex m;
   ros::NodeHandle nh;
-  auto sub = nh.subscribe<nav_msgs::OccupancyGrid>(
-      "map_scale_5", 2,
-      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
-          [&](const nav_msgs::OccupancyGrid::ConstPtr& g) {
-            std::lock_guard<std::mutex> lock(m);
-            g5 = g;
-          }));
+  auto sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map_scale_5", 2, &m, &g5);
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(5.0);
   while (ros::WallTime::now() < end) {
     {
@@ -358,13 +352,7 @@ int main(int argc, char** argv) {
   tf2_ros::StaticTransformBroadcaster static_tf;
   static_tf.sendTransform(room::staticTree());
   g_scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 50);
-  auto map_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
-      "map", 2,
-      boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
-          [](const nav_msgs::OccupancyGrid::ConstPtr& g) {
-            std::lock_guard<std::mutex> lock(g_mutex);
-            g_map = g;
-          }));
+  auto map_sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map", 2, &g_mutex, &g_map);
   auto restored_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
       "restored/map", 2,
       boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(
