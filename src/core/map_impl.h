@@ -126,7 +126,9 @@ inline void setBit(std::uint8_t* mask, std::uint8_t bit, bool on) {
 
 /// Largest stored detail magnitude of a node (stored, without pending tags).
 inline float maxAbsDetail(const Node& n) {
-  return std::fmax(std::fabs(n.d[0]), std::fmax(std::fabs(n.d[1]), std::fabs(n.d[2])));
+  const float a = std::fabs(n.d[0]), b = std::fabs(n.d[1]), c = std::fabs(n.d[2]);
+  const float ab = a > b ? a : b;
+  return ab > c ? ab : c;
 }
 
 }  // namespace detail

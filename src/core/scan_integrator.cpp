@@ -49,6 +49,22 @@ inline double fastAtan2(double y, double x) {
   return y < 0 ? -r : r;
 }
 
+/// What classifying a square learned: its class and the beams whose sectors may meet it, which
+/// its sub-squares and cells inherit (they lie inside it).
+struct BoxInfo {
+  CellClass cls = CellClass::kMixed;
+  int jlo = 0, jhi = -1;  ///< beams whose sector may hold a point of the square (a superset)
+  bool single = false;    ///< every point of the square lies in sector jlo (jlo == jhi), in the fan
+  bool narrow = false;    ///< in the fan, and few enough beams for the boundary-ray tests
+};
+
+// Most beams a narrow square may span: its sub-squares and cells find their sectors by testing
+// the sector boundaries in between (cross products) instead of computing bearings.
+constexpr int kNarrowBeams = 6;
+// Margin of the boundary-ray side tests, in radians (far above the rounding of the reference's
+// bearings and of the boundary directions).
+constexpr double kRayMargin = 1e-9;
+
 /// Everything about one scan that node and cell classification need. Reused between scans.
 struct PreparedScan {
   double px = 0, py = 0, theta = 0;  // sensor pose
@@ -60,9 +76,17 @@ struct PreparedScan {
   std::vector<float> ranges;         // work copy (reordered when inc < 0)
   std::vector<std::uint8_t> kind;
   std::vector<double> ze, zu;
-  std::vector<double> min_ze, max_zu;  // sparse tables, level-major, n entries per level
+  std::vector<double> ze2, zu2;        // sq(ze), sq(zu): squares of the limits (see sq() below)
+  double reach2 = 0;                   // sq(reach)
+  std::vector<double> min_ze, max_zu;  // sparse tables of ze2, zu2, level-major, n per level
   std::vector<int> invalid_prefix;     // invalid_prefix[j] = #invalid beams in [0, j)
   std::vector<std::uint64_t> hits;     // sorted cell keys of hit endpoints
+  std::vector<std::int64_t> hit_x, hit_y;  // per beam: the cell of its endpoint (hit beams)
+  double fast_guard = 0;               // |t - (j + 1/2)| beyond which fastAtan2 gives lround(t)
+  double seam_map = 0;                 // theta + seam reduced to [-pi, pi): the seam, map frame
+  double inv_inc = 0, t_seam = 0;      // 1 / inc and (seam - amin) / inc
+  bool narrow_ok = false;              // kNarrowBeams + 1 sectors span less than pi / 2
+  std::vector<double> bnd_x, bnd_y;    // boundary k between sectors k-1 and k: unit direction
 
   static std::uint64_t cellKey(std::int64_t ix, std::int64_t iy) {
     return (static_cast<std::uint64_t>(ix + (std::int64_t{1} << 31)) << 32) ^
@@ -73,21 +97,109 @@ struct PreparedScan {
     return bearing - kTwoPi * std::floor((bearing - seam) / kTwoPi);
   }
 
-  /// Class of the finest cell (ix, iy): O if a hit falls in it (O wins), else sampled at the
-  /// cell centre with the sector model. The dense reference in test/core repeats this rule.
-  CellClass classifyCell(std::int64_t ix, std::int64_t iy) const {
-    if (std::binary_search(hits.begin(), hits.end(), cellKey(ix, iy))) return CellClass::kOccupied;
+  /// Class of the finest cell (ix, iy) of a square classified as `box`: O if a hit falls in it
+  /// (O wins), else sampled at the cell centre with the sector model. The dense reference in
+  /// test/core repeats this rule with std::atan2 cell by cell; this gives the same class faster:
+  /// only beams of `box` can have their endpoint in the cell, and in a single-beam square the
+  /// sector is known without any bearing.
+  CellClass classifyCell(std::int64_t ix, std::int64_t iy, const BoxInfo& box) const {
     const double dx = (static_cast<double>(ix) + 0.5) * res - px;
     const double dy = (static_cast<double>(iy) + 0.5) * res - py;
-    const double rho = std::sqrt(dx * dx + dy * dy);
-    const double beta = normalise(std::atan2(dy, dx) - theta);
-    const long j = std::lround((beta - amin) / inc);
-    if (j < 0 || j >= n) return CellClass::kUnknown;
-    const auto ju = static_cast<std::size_t>(j);
+    std::size_t ju;
+    if (box.single) {
+      ju = static_cast<std::size_t>(box.jlo);
+      if (kind[ju] == kHit && hit_x[ju] == ix && hit_y[ju] == iy) return CellClass::kOccupied;
+    } else {
+      if (isHitCell(ix, iy, box)) return CellClass::kOccupied;
+      const long j = box.narrow ? beamIn(dx, dy, box) : beamOf(dx, dy);
+      if (j < 0 || j >= n) return CellClass::kUnknown;
+      ju = static_cast<std::size_t>(j);
+    }
     if (kind[ju] == kInvalid) return CellClass::kUnknown;
+    const double rho = std::sqrt(dx * dx + dy * dy);
     if (rho < ze[ju]) return CellClass::kEmpty;
     if (kind[ju] == kHit && rho <= zu[ju]) return CellClass::kOccupied;
     return CellClass::kUnknown;
+  }
+
+  /// Classes of the 4 cells of the 2x2 square at (ix0, iy0), in child order q = x + 2y.
+  void classifyQuad(std::int64_t ix0, std::int64_t iy0, const BoxInfo& box,
+                    std::array<CellClass, 4>* out) const {
+    if (!box.single) {
+      for (int q = 0; q < 4; ++q) {
+        (*out)[static_cast<std::size_t>(q)] = classifyCell(ix0 + (q & 1), iy0 + (q >> 1), box);
+      }
+      return;
+    }
+    // One sector for all four: the same tests as classifyCell, with shared loads.
+    const auto j = static_cast<std::size_t>(box.jlo);
+    const std::uint8_t k = kind[j];
+    const double e = ze[j], u = zu[j];
+    const double dx[2] = {(static_cast<double>(ix0) + 0.5) * res - px,
+                          (static_cast<double>(ix0 + 1) + 0.5) * res - px};
+    const double dy[2] = {(static_cast<double>(iy0) + 0.5) * res - py,
+                          (static_cast<double>(iy0 + 1) + 0.5) * res - py};
+    for (int q = 0; q < 4; ++q) {
+      const double ex = dx[q & 1], ey = dy[q >> 1];
+      const double rho = std::sqrt(ex * ex + ey * ey);
+      CellClass c = CellClass::kUnknown;
+      if (k == kInvalid) {
+        c = CellClass::kUnknown;
+      } else if (k == kHit && hit_x[j] == ix0 + (q & 1) && hit_y[j] == iy0 + (q >> 1)) {
+        c = CellClass::kOccupied;
+      } else if (rho < e) {
+        c = CellClass::kEmpty;
+      } else if (k == kHit && rho <= u) {
+        c = CellClass::kOccupied;
+      }
+      (*out)[static_cast<std::size_t>(q)] = c;
+    }
+  }
+
+  /// True if a hit endpoint lies in cell (ix, iy) of square `box` (only its beams can).
+  bool isHitCell(std::int64_t ix, std::int64_t iy, const BoxInfo& box) const {
+    constexpr int kScanLimit = 8;
+    if (box.jhi - box.jlo >= kScanLimit) {
+      return std::binary_search(hits.begin(), hits.end(), cellKey(ix, iy));
+    }
+    for (int j = box.jlo; j <= box.jhi; ++j) {
+      const auto ju = static_cast<std::size_t>(j);
+      if (kind[ju] == kHit && hit_x[ju] == ix && hit_y[ju] == iy) return true;
+    }
+    return false;
+  }
+
+  /// lround((normalise(atan2(dy, dx) - theta) - amin) / inc), as the reference computes it: the
+  /// polynomial atan2 decides unless its error could move the result across a rounding boundary
+  /// or the seam, then std::atan2 does.
+  long beamOf(double dx, double dy) const {
+    const double off = offSeam(fastAtan2(dy, dx));
+    const double u = off * inv_inc + t_seam + 0.5;  // lround(t) = floor(t + 1/2) off the halves
+    const double f = std::floor(u);
+    if (u - f > fast_guard && u - f < 1.0 - fast_guard && off > kFastAtanError &&
+        off < kTwoPi - kFastAtanError) {
+      return static_cast<long>(f);
+    }
+    return std::lround((normalise(std::atan2(dy, dx) - theta) - amin) / inc);
+  }
+
+  /// Side of direction (dx, dy) against sector boundary k: +1 past it (counter-clockwise), -1
+  /// before it, 0 too close to tell (within kRayMargin radians).
+  int side(std::size_t k, double dx, double dy) const {
+    const double c = bnd_x[k] * dy - bnd_y[k] * dx;
+    const double tol = kRayMargin * (std::fabs(dx) + std::fabs(dy));
+    return c > tol ? 1 : (c < -tol ? -1 : 0);
+  }
+
+  /// beamOf() for a cell of a narrow square: its sector is jlo plus the boundaries it is past.
+  long beamIn(double dx, double dy, const BoxInfo& box) const {
+    long j = box.jlo;
+    for (int k = box.jlo + 1; k <= box.jhi; ++k) {
+      const int sd = side(static_cast<std::size_t>(k), dx, dy);
+      if (sd == 0) return beamOf(dx, dy);  // on a boundary: the reference's rounding decides
+      j += sd > 0 ? 1 : 0;
+    }
+    return j;
   }
 
   double queryMin(int lo, int hi) const {
@@ -103,45 +215,141 @@ struct PreparedScan {
                     max_zu[base + static_cast<std::size_t>(hi - (1 << k) + 1)]);
   }
 
-  /// Class of the square of side 2^l cells at cell (ix0, iy0), conservative: kEmpty only if
-  /// every cell in it is E, kUnknown only if every cell is U, kFreeOrUnknown only if no cell is O.
-  CellClass classifyBox(int l, std::int64_t ix0, std::int64_t iy0) const {
+  /// Squared distance limit, monotone in z: squares compare like the distances (-1 for z <= 0,
+  /// which no distance is below). Squares spare a square root per test; at leaves the exact
+  /// distance is kept, as the reference compares it.
+  static double sq(double z) { return z > 0.0 ? z * z : -1.0; }
+
+  /// Class of the square of side 2^l cells at cell (ix0, iy0) inside a square classified as
+  /// `parent`: a sub-square of a single-beam square needs ranges only.
+  BoxInfo classifyBox(int l, std::int64_t ix0, std::int64_t iy0, const BoxInfo& parent) const {
+    if (parent.single) {
+      BoxInfo info = parent;
+      info.cls = classifyInBeam(l, ix0, iy0, static_cast<std::size_t>(parent.jlo));
+      return info;
+    }
+    if (parent.narrow) return classifyInRange(l, ix0, iy0, parent);
+    return classifyBox(l, ix0, iy0);
+  }
+
+  /// Corners of the square [x0, x1] x [y0, y1] (not holding the sensor) that bound its bearing
+  /// interval, counter-clockwise first (a) and last (b), as offsets from the sensor. Which
+  /// corners they are follows from where the sensor lies: left / right / within in x, below /
+  /// above / within in y.
+  void extremeCorners(double x0, double y0, double x1, double y1, double* ax, double* ay,
+                      double* bx, double* by) const {
+    if (px < x0) {
+      if (py < y0) {
+        *ax = x1, *ay = y0, *bx = x0, *by = y1;
+      } else if (py > y1) {
+        *ax = x0, *ay = y0, *bx = x1, *by = y1;
+      } else {
+        *ax = x0, *ay = y0, *bx = x0, *by = y1;
+      }
+    } else if (px > x1) {
+      if (py < y0) {
+        *ax = x1, *ay = y1, *bx = x0, *by = y0;
+      } else if (py > y1) {
+        *ax = x0, *ay = y1, *bx = x1, *by = y0;
+      } else {
+        *ax = x1, *ay = y1, *bx = x1, *by = y0;
+      }
+    } else if (py < y0) {
+      *ax = x1, *ay = y0, *bx = x0, *by = y0;
+    } else {
+      *ax = x0, *ay = y1, *bx = x1, *by = y1;
+    }
+    *ax -= px, *ay -= py, *bx -= px, *by -= py;
+  }
+
+  /// classifyBox() for a sub-square of a narrow square: its beams are those of the parent
+  /// between the boundaries its first corner is surely past and those its last corner may be
+  /// past (conservative both ways).
+  BoxInfo classifyInRange(int l, std::int64_t ix0, std::int64_t iy0, const BoxInfo& parent) const {
     const double size = static_cast<double>(std::int64_t{1} << l) * res;
     const double x0 = static_cast<double>(ix0) * res, y0 = static_cast<double>(iy0) * res;
     const double x1 = x0 + size, y1 = y0 + size;
-    if (px >= x0 && px <= x1 && py >= y0 && py <= y1) return CellClass::kMixed;
-    const double nx = std::max({x0 - px, 0.0, px - x1}), ny = std::max({y0 - py, 0.0, py - y1});
-    const double r_min = std::sqrt(nx * nx + ny * ny);
-    if (r_min > reach) return CellClass::kUnknown;
+    BoxInfo info = parent;
+    double ax, ay, bx, by;
+    extremeCorners(x0, y0, x1, y1, &ax, &ay, &bx, &by);
+    for (int k = parent.jlo + 1; k <= parent.jhi; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      if (side(ku, ax, ay) > 0) info.jlo = k;   // a surely in sector k or later
+      if (side(ku, bx, by) < 0) {               // b surely before sector k
+        info.jhi = k - 1;
+        break;
+      }
+    }
+    info.single = info.jlo == info.jhi;
+    info.cls = rangeClass(x0, y0, x1, y1, info.jlo, info.jhi, false);
+    return info;
+  }
+
+  /// Class of the square [x0, x1] x [y0, y1] whose cells lie in sectors jlo..jhi (`partial`: or
+  /// outside the fan), from its distance range against the beams' limits.
+  CellClass rangeClass(double x0, double y0, double x1, double y1, int jlo, int jhi,
+                       bool partial) const {
+    const double nx = std::max(std::max(x0 - px, 0.0), px - x1);
+    const double ny = std::max(std::max(y0 - py, 0.0), py - y1);
+    if (nx * nx + ny * ny > queryMax(jlo, jhi)) return CellClass::kUnknown;
     const double fx = std::max(std::fabs(x0 - px), std::fabs(x1 - px));
     const double fy = std::max(std::fabs(y0 - py), std::fabs(y1 - py));
-    const double r_max = std::sqrt(fx * fx + fy * fy);
-
-    // Bearing interval of the square (convex, not containing the sensor: span < pi).
-    double b[4] = {normalise(fastAtan2(y0 - py, x0 - px) - theta),
-                   normalise(fastAtan2(y0 - py, x1 - px) - theta),
-                   normalise(fastAtan2(y1 - py, x0 - px) - theta),
-                   normalise(fastAtan2(y1 - py, x1 - px) - theta)};
-    double lo = std::min({b[0], b[1], b[2], b[3]}), hi = std::max({b[0], b[1], b[2], b[3]});
-    bool straddles = false;
-    if (hi - lo > kPi) {  // crosses the seam behind the field of view: unwrap
-      straddles = true;
-      for (double& v : b) {
-        if (v < seam + kPi) v += kTwoPi;
-      }
-      lo = std::min({b[0], b[1], b[2], b[3]});
-      hi = std::max({b[0], b[1], b[2], b[3]});
+    if (fx * fx + fy * fy < queryMin(jlo, jhi)) {
+      const bool any_invalid = invalid_prefix[static_cast<std::size_t>(jhi) + 1] >
+                               invalid_prefix[static_cast<std::size_t>(jlo)];
+      return (partial || any_invalid) ? CellClass::kFreeOrUnknown : CellClass::kEmpty;
     }
+    return CellClass::kMixed;
+  }
+
+  /// Class of a square that lies in sector j (not holding the sensor). Only beam j can put a hit
+  /// in it, so the class follows from its distance range against ze[j], zu[j].
+  CellClass classifyInBeam(int l, std::int64_t ix0, std::int64_t iy0, std::size_t j) const {
+    const double size = static_cast<double>(std::int64_t{1} << l) * res;
+    const double x0 = static_cast<double>(ix0) * res, y0 = static_cast<double>(iy0) * res;
+    const double x1 = x0 + size, y1 = y0 + size;
+    const double nx = std::max({x0 - px, 0.0, px - x1}), ny = std::max({y0 - py, 0.0, py - y1});
+    if (nx * nx + ny * ny > zu2[j]) return CellClass::kUnknown;  // also invalid beams (zu2 = -1)
+    const double fx = std::max(std::fabs(x0 - px), std::fabs(x1 - px));
+    const double fy = std::max(std::fabs(y0 - py), std::fabs(y1 - py));
+    if (fx * fx + fy * fy < ze2[j]) return CellClass::kEmpty;
+    return kind[j] == kClear ? CellClass::kFreeOrUnknown : CellClass::kMixed;
+  }
+
+  /// Class of the square of side 2^l cells at cell (ix0, iy0), conservative: kEmpty only if
+  /// every cell in it is E, kUnknown only if every cell is U, kFreeOrUnknown only if no cell is O.
+  BoxInfo classifyBox(int l, std::int64_t ix0, std::int64_t iy0) const {
+    BoxInfo info;
+    info.jlo = 0;
+    info.jhi = n - 1;
+    const double size = static_cast<double>(std::int64_t{1} << l) * res;
+    const double x0 = static_cast<double>(ix0) * res, y0 = static_cast<double>(iy0) * res;
+    const double x1 = x0 + size, y1 = y0 + size;
+    const double nx = std::max(std::max(x0 - px, 0.0), px - x1);
+    const double ny = std::max(std::max(y0 - py, 0.0), py - y1);
+    if (nx == 0.0 && ny == 0.0) return info;  // holds the sensor (boundary included)
+    info.cls = CellClass::kUnknown;
+    if (nx * nx + ny * ny > reach2) return info;
+
+    // Bearing interval of the square (convex, not holding the sensor: span < pi).
+    double ax, ay, bx, by;
+    extremeCorners(x0, y0, x1, y1, &ax, &ay, &bx, &by);
+    // Offsets past the seam, in [0, 2 pi); the square wraps the seam when the last is below the
+    // first, and is then unwrapped.
+    const double lo = offSeam(fastAtan2(ay, ax));
+    double hi = offSeam(fastAtan2(by, bx));
+    const bool straddles = hi < lo;
+    if (straddles) hi += kTwoPi;
     // Beams j whose sector may hold a point of [lo, hi]: the cells' lround() lands in [jlo, jhi].
     auto beamRange = [&](double a_lo, double a_hi, long* jlo, long* jhi) {
-      const double t_lo = (a_lo - kFastAtanError - amin) / inc - 0.5 - kIndexSlack;
-      const double t_hi = (a_hi + kFastAtanError - amin) / inc + 0.5 + kIndexSlack;
+      const double t_lo = (a_lo - kFastAtanError) * inv_inc + t_seam - 0.5 - kIndexSlack;
+      const double t_hi = (a_hi + kFastAtanError) * inv_inc + t_seam + 0.5 + kIndexSlack;
       *jlo = static_cast<long>(std::ceil(std::max(t_lo, -1.0)));
       *jhi = static_cast<long>(std::floor(std::min(t_hi, static_cast<double>(n))));
     };
     long jlo, jhi;
     beamRange(lo, hi, &jlo, &jhi);
-    bool partial = straddles || jlo < 0 || jhi > n - 1;
+    const bool partial = straddles || jlo < 0 || jhi > n - 1;
     jlo = std::max(jlo, 0L);
     jhi = std::min(jhi, static_cast<long>(n - 1));
     if (straddles) {
@@ -159,17 +367,23 @@ struct PreparedScan {
         }
       }
     }
-    if (jlo > jhi) return CellClass::kUnknown;
+    if (jlo > jhi) return info;
     const int ilo = static_cast<int>(jlo), ihi = static_cast<int>(jhi);
-    const double zu_max = queryMax(ilo, ihi);
-    if (r_min > zu_max) return CellClass::kUnknown;
-    const double ze_min = queryMin(ilo, ihi);
-    if (r_max < ze_min) {
-      const bool any_invalid =
-          invalid_prefix[static_cast<std::size_t>(ihi) + 1] > invalid_prefix[static_cast<std::size_t>(ilo)];
-      return (partial || any_invalid) ? CellClass::kFreeOrUnknown : CellClass::kEmpty;
-    }
-    return CellClass::kMixed;
+    info.jlo = ilo;
+    info.jhi = ihi;
+    info.single = !partial && ilo == ihi;
+    info.narrow = !partial && narrow_ok && ihi - ilo <= kNarrowBeams;
+    info.cls = rangeClass(x0, y0, x1, y1, ilo, ihi, partial);
+    return info;
+  }
+
+  /// A map-frame direction angle (from fastAtan2, in [-pi, pi]) as its sensor-frame bearing's
+  /// offset past the seam, in [0, 2 pi). Within a few ulps of normalise() - seam.
+  double offSeam(double map_angle) const {
+    double v = map_angle - seam_map;
+    if (v < 0.0) v += kTwoPi;
+    if (v >= kTwoPi) v -= kTwoPi;
+    return v;
   }
 };
 
@@ -217,6 +431,20 @@ ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& s
   ps->zu.assign(nu, -inf);
   ps->invalid_prefix.assign(nu + 1, 0);
   ps->hits.clear();
+  ps->hit_x.assign(nu, 0);
+  ps->hit_y.assign(nu, 0);
+  ps->fast_guard = kFastAtanError / ps->inc + kIndexSlack;
+  ps->seam_map = std::remainder(ps->theta + ps->seam, kTwoPi);
+  ps->inv_inc = 1.0 / ps->inc;
+  ps->t_seam = (ps->seam - ps->amin) / ps->inc;
+  ps->narrow_ok = ps->inc * (kNarrowBeams + 1) < 0.5 * kPi;
+  ps->bnd_x.resize(nu + 1);
+  ps->bnd_y.resize(nu + 1);
+  for (std::size_t k = 0; k <= nu; ++k) {
+    const double b = ps->theta + ps->amin + (static_cast<double>(k) - 0.5) * ps->inc;
+    ps->bnd_x[k] = std::cos(b);
+    ps->bnd_y[k] = std::sin(b);
+  }
   ps->reach = 0.0;
   for (std::size_t j = 0; j < nu; ++j) {
     const double z = ps->ranges[j];
@@ -237,8 +465,9 @@ ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& s
       ps->zu[j] = z + half_band;
       const double bearing = pose.theta + (ps->amin + static_cast<double>(j) * ps->inc);
       const double ex = pose.x + z * std::cos(bearing), ey = pose.y + z * std::sin(bearing);
-      ps->hits.push_back(PreparedScan::cellKey(static_cast<std::int64_t>(std::floor(ex / ps->res)),
-                                               static_cast<std::int64_t>(std::floor(ey / ps->res))));
+      ps->hit_x[j] = static_cast<std::int64_t>(std::floor(ex / ps->res));
+      ps->hit_y[j] = static_cast<std::int64_t>(std::floor(ey / ps->res));
+      ps->hits.push_back(PreparedScan::cellKey(ps->hit_x[j], ps->hit_y[j]));
     }
     ps->kind[j] = kind;
     if (kind != kInvalid) ps->reach = std::max(ps->reach, ps->zu[j]);
@@ -253,8 +482,15 @@ ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& s
   while ((1 << levels) <= n) ++levels;
   ps->min_ze.resize(static_cast<std::size_t>(levels) * nu);
   ps->max_zu.resize(static_cast<std::size_t>(levels) * nu);
-  std::copy(ps->ze.begin(), ps->ze.end(), ps->min_ze.begin());
-  std::copy(ps->zu.begin(), ps->zu.end(), ps->max_zu.begin());
+  ps->ze2.resize(nu);
+  ps->zu2.resize(nu);
+  for (std::size_t j = 0; j < nu; ++j) {
+    ps->ze2[j] = PreparedScan::sq(ps->ze[j]);
+    ps->zu2[j] = PreparedScan::sq(ps->zu[j]);
+  }
+  ps->reach2 = PreparedScan::sq(ps->reach);
+  std::copy(ps->ze2.begin(), ps->ze2.end(), ps->min_ze.begin());
+  std::copy(ps->zu2.begin(), ps->zu2.end(), ps->max_zu.begin());
   for (int k = 1; k < levels; ++k) {
     const std::size_t base = static_cast<std::size_t>(k) * nu, prev = base - nu;
     const std::size_t half = std::size_t{1} << (k - 1);
@@ -297,25 +533,25 @@ class Integrator {
 
   std::uint64_t visited() const { return visited_; }
 
-  void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, CellClass cls) {
+  void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, const BoxInfo& box) {
     const int L = impl_.levels;
     Node* root = b.has_root ? &b.root : nullptr;
     bool all = b.known_all, any = b.known_any;
     b.s += processSlot(
-        root, cls, L, ix0, iy0, b.s, &all, &any,
+        root, box, L, ix0, iy0, b.s, &all, &any,
         [&](const Node& m) { impl_.installRoot(&b, m); }, [&]() { impl_.removeRoot(&b); });
     b.known_all = all;
     b.known_any = any;
   }
 
  private:
-  // Updates one slot (a node at level l >= 1, or a uniform block when `node` is null) of class
-  // `cls` whose average is s; returns the change of that average. `all`/`any` are the slot's
+  // Updates one slot (a node at level l >= 1, or a uniform block when `node` is null) classified
+  // as `box` whose average is s; returns the change of that average. `all`/`any` are the slot's
   // knowledge bits, updated. install(m) stores a new node, remove() deletes the existing one.
   template <typename Install, typename Remove>
-  double processSlot(Node* node, CellClass cls, int l, std::int64_t ix0, std::int64_t iy0,
+  double processSlot(Node* node, const BoxInfo& box, int l, std::int64_t ix0, std::int64_t iy0,
                      double s, bool* all, bool* any, Install install, Remove remove) {
-    switch (cls) {
+    switch (box.cls) {
       case CellClass::kUnknown:
         return 0.0;
       case CellClass::kEmpty:
@@ -350,16 +586,18 @@ class Integrator {
     }
     Node tmp = WaveletMap::Impl::uniformSlot(*all, *any);
     Node& m = node ? *node : tmp;
-    const double ds = visitNode(m, l, ix0, iy0, s);
+    const double ds = visitNode(m, box, l, ix0, iy0, s);
     impl_.settleSlot(m, node != nullptr, all, any, install, remove);
     return ds;
   }
 
   // Descends through node n (level l, average s): flushes its tag (F1), updates its 4 children,
   // folds their average changes into n's details with one forward Haar step.
-  double visitNode(Node& n, int l, std::int64_t ix0, std::int64_t iy0, double s) {
+  double visitNode(Node& n, const BoxInfo& box, int l, std::int64_t ix0, std::int64_t iy0,
+                   double s) {
     ++visited_;
-    impl_.flush(n);
+    if (n.k != 0) impl_.flush(n);
+    if (l == 1) return visitLeafParent(n, box, ix0, iy0, s);
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     const std::int64_t half = std::int64_t{1} << (l - 1);
@@ -367,25 +605,40 @@ class Integrator {
       const auto qu = static_cast<std::size_t>(q);
       const std::int64_t cx = ix0 + ((q & 1) ? half : 0), cy = iy0 + ((q & 2) ? half : 0);
       const auto bit = static_cast<std::uint8_t>(1u << q);
-      if (l == 1) {
-        ++visited_;
-        const CellClass cls = ps_.classifyCell(cx, cy);
-        if (cls == CellClass::kUnknown) continue;
-        delta[qu] = applyPolicy<P>(pc_, cls, c[qu]) - c[qu];
-        n.known_all |= bit;
-        n.known_any |= bit;
-        continue;
-      }
-      const CellClass cls = ps_.classifyBox(l - 1, cx, cy);
+      const BoxInfo child_box = ps_.classifyBox(l - 1, cx, cy, box);
       ++visited_;
+      if (child_box.cls == CellClass::kUnknown) continue;
       Node* ch = impl_.hasChild(n, q) ? &impl_.child(n, q) : nullptr;
       bool all = (n.known_all & bit) != 0, any = (n.known_any & bit) != 0;
       delta[qu] = processSlot(
-          ch, cls, l - 1, cx, cy, c[qu], &all, &any,
+          ch, child_box, l - 1, cx, cy, c[qu], &all, &any,
           [&](const Node& m) { impl_.installChild(n, q, m); }, [&]() { impl_.removeChild(n, q); });
       detail::setBit(&n.known_all, bit, all);
       detail::setBit(&n.known_any, bit, any);
     }
+    return foldChanges(n, delta);
+  }
+
+  // A level-1 node: its children are finest cells, classified together.
+  double visitLeafParent(Node& n, const BoxInfo& box, std::int64_t ix0, std::int64_t iy0,
+                         double s) {
+    visited_ += 4;
+    std::array<CellClass, 4> cls;
+    ps_.classifyQuad(ix0, iy0, box, &cls);
+    const std::array<double, 4> c = haar::backward(s, n.d);
+    std::array<double, 4> delta{};
+    for (std::size_t q = 0; q < 4; ++q) {
+      if (cls[q] == CellClass::kUnknown) continue;
+      delta[q] = applyPolicy<P>(pc_, cls[q], c[q]) - c[q];
+      n.known_all = static_cast<std::uint8_t>(n.known_all | (1u << q));
+      n.known_any = static_cast<std::uint8_t>(n.known_any | (1u << q));
+    }
+    return foldChanges(n, delta);
+  }
+
+  // Folds the children's average changes into n's details (one forward Haar step); returns the
+  // change of n's average.
+  static double foldChanges(Node& n, const std::array<double, 4>& delta) {
     haar::Details<double> dd;
     const double ds = haar::forward(delta, &dd);
     for (int i = 0; i < 3; ++i) {
@@ -433,11 +686,11 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const PreparedScan& ps, Integ
   for (std::int64_t by = lo_y; by <= hi_y; ++by) {
     for (std::int64_t bx = lo_x; bx <= hi_x; ++bx) {
       const std::int64_t ix0 = detail::scaleUp(bx, L), iy0 = detail::scaleUp(by, L);
-      const CellClass cls = ps.classifyBox(L, ix0, iy0);
+      const BoxInfo box = ps.classifyBox(L, ix0, iy0);
       ++visited;
-      if (cls == CellClass::kUnknown) continue;
+      if (box.cls == CellClass::kUnknown) continue;
       ++st->blocks_touched;
-      integrator.integrateBlock(impl.getOrCreateBlock(bx, by), ix0, iy0, cls);
+      integrator.integrateBlock(impl.getOrCreateBlock(bx, by), ix0, iy0, box);
     }
   }
   return visited + integrator.visited();

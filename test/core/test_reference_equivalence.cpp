@@ -127,6 +127,36 @@ TEST(ReferenceEquivalence, DegenerateGeometry) {
   run.expectMultiscale(4);
 }
 
+// Many beams whose sector boundaries run exactly through cell centres and corners (sensor on a
+// cell centre or corner, boundaries on the axes and diagonals), with neighbouring sectors that
+// disagree: the boundary-ray tests must hand those cells to the same sector as the reference.
+TEST(ReferenceEquivalence, SectorBoundariesThroughCellCentres) {
+  const double res = 0.1;
+  PolicyRun run(everyPolicy(res, 5), CellBox{-96, -96, 96, 96});
+  const double kPi = 3.14159265358979323846;
+  const int beams = 128;
+  const double inc = 2 * kPi / beams;
+  for (int i = 0; i < 24; ++i) {
+    OwnedScan s;
+    const double off = (i % 2) ? 0.5 * res : 0.0;  // cell centre or cell corner
+    s.pose = {off + res * static_cast<double>(i % 5 - 2), off - res * static_cast<double>(i % 3),
+              (i % 8) * kPi / 4};
+    s.angle_min = -kPi + 0.5 * inc;  // boundaries at multiples of inc, axes and diagonals included
+    s.angle_increment = (i % 3 == 2) ? -inc : inc;
+    if (s.angle_increment < 0) s.angle_min = kPi - 0.5 * inc;
+    s.range_min = 0.0;
+    s.range_max = 8.0;
+    for (int j = 0; j < beams; ++j) {
+      float r = (j + i) % 2 ? 0.65f : 3.05f + 0.1f * static_cast<float>(j % 4);
+      if (j % 29 == 3) r = std::numeric_limits<float>::quiet_NaN();
+      if (j % 31 == 7) r = std::numeric_limits<float>::infinity();
+      s.ranges.push_back(r);
+    }
+    run.integrate(s);
+  }
+  run.expectEqual("boundaries through cell centres");
+}
+
 // (b) The first 500 scans of the Freiburg fr079 log.
 TEST(ReferenceEquivalence, Fr079First500Scans) {
   const std::string dir = dataDir();
