@@ -55,12 +55,10 @@ struct BoxInfo {
   CellClass cls = CellClass::kMixed;
   int jlo = 0, jhi = -1;  ///< beams whose sector may hold a point of the square (a superset)
   bool single = false;    ///< every point of the square lies in sector jlo (jlo == jhi), in the fan
-  bool narrow = false;    ///< in the fan, and few enough beams for the boundary-ray tests
+  bool narrow = false;    ///< in the fan, and its sectors span under pi / 2: the sub-squares and
+                          ///< cells find theirs by testing the boundaries (no bearings)
 };
 
-// Most beams a narrow square may span: its sub-squares and cells find their sectors by testing
-// the sector boundaries in between (cross products) instead of computing bearings.
-constexpr int kNarrowBeams = 6;
 // Margin of the boundary-ray side tests, in radians (far above the rounding of the reference's
 // bearings and of the boundary directions).
 constexpr double kRayMargin = 1e-9;
@@ -85,7 +83,6 @@ struct PreparedScan {
   double fast_guard = 0;               // |t - (j + 1/2)| beyond which fastAtan2 gives lround(t)
   double seam_map = 0;                 // theta + seam reduced to [-pi, pi): the seam, map frame
   double inv_inc = 0, t_seam = 0;      // 1 / inc and (seam - amin) / inc
-  bool narrow_ok = false;              // kNarrowBeams + 1 sectors span less than pi / 2
   std::vector<double> bnd_x, bnd_y;    // boundary k between sectors k-1 and k: unit direction
 
   static std::uint64_t cellKey(std::int64_t ix, std::int64_t iy) {
@@ -183,21 +180,45 @@ struct PreparedScan {
     return std::lround((normalise(std::atan2(dy, dx) - theta) - amin) / inc);
   }
 
-  /// Side of direction (dx, dy) against sector boundary k: +1 past it (counter-clockwise), -1
-  /// before it, 0 too close to tell (within kRayMargin radians).
-  int side(std::size_t k, double dx, double dy) const {
-    const double c = bnd_x[k] * dy - bnd_y[k] * dx;
-    const double tol = kRayMargin * (std::fabs(dx) + std::fabs(dy));
-    return c > tol ? 1 : (c < -tol ? -1 : 0);
+  // Sector boundaries by cross products. Within a narrow square's sectors (under pi / 2) the
+  // side of a direction against boundary k is monotone in k, so the tests bisect. "Surely" means
+  // by more than kRayMargin radians (tol = kRayMargin * (|dx| + |dy|) bounds that from above).
+
+  /// Largest k in [lo, hi] such that (dx, dy) is surely past boundary k (lo when none is tested).
+  int lastSurelyPast(double dx, double dy, double tol, int lo, int hi) const {
+    while (lo < hi) {
+      const int mid = lo + (hi - lo + 1) / 2;
+      const auto m = static_cast<std::size_t>(mid);
+      if (bnd_x[m] * dy - bnd_y[m] * dx > tol) {
+        lo = mid;
+      } else {
+        hi = mid - 1;
+      }
+    }
+    return lo;
+  }
+  /// Largest k in [lo, hi] such that (dx, dy) is not surely before boundary k (lo when none).
+  int lastNotSurelyBefore(double dx, double dy, double tol, int lo, int hi) const {
+    while (lo < hi) {
+      const int mid = lo + (hi - lo + 1) / 2;
+      const auto m = static_cast<std::size_t>(mid);
+      if (bnd_x[m] * dy - bnd_y[m] * dx < -tol) {
+        hi = mid - 1;
+      } else {
+        lo = mid;
+      }
+    }
+    return lo;
   }
 
-  /// beamOf() for a cell of a narrow square: its sector is jlo plus the boundaries it is past.
+  /// beamOf() for a cell of a narrow square: the last boundary it is surely past, unless it is
+  /// too close to the next one to tell (then the reference's rounding decides, via beamOf).
   long beamIn(double dx, double dy, const BoxInfo& box) const {
-    long j = box.jlo;
-    for (int k = box.jlo + 1; k <= box.jhi; ++k) {
-      const int sd = side(static_cast<std::size_t>(k), dx, dy);
-      if (sd == 0) return beamOf(dx, dy);  // on a boundary: the reference's rounding decides
-      j += sd > 0 ? 1 : 0;
+    const double tol = kRayMargin * (std::fabs(dx) + std::fabs(dy));
+    const int j = lastSurelyPast(dx, dy, tol, box.jlo, box.jhi);
+    if (j < box.jhi) {
+      const auto m = static_cast<std::size_t>(j + 1);
+      if (!(bnd_x[m] * dy - bnd_y[m] * dx < -tol)) return beamOf(dx, dy);
     }
     return j;
   }
@@ -262,8 +283,8 @@ struct PreparedScan {
     *ax -= px, *ay -= py, *bx -= px, *by -= py;
   }
 
-  /// classifyBox() for a sub-square of a narrow square: its beams are those of the parent
-  /// between the boundaries its first corner is surely past and those its last corner may be
+  /// classifyBox() for a sub-square of a narrow square: its beams are those of the parent from
+  /// the last boundary its first corner is surely past to the last one its last corner may be
   /// past (conservative both ways).
   BoxInfo classifyInRange(int l, std::int64_t ix0, std::int64_t iy0, const BoxInfo& parent) const {
     const double size = static_cast<double>(std::int64_t{1} << l) * res;
@@ -272,14 +293,10 @@ struct PreparedScan {
     BoxInfo info = parent;
     double ax, ay, bx, by;
     extremeCorners(x0, y0, x1, y1, &ax, &ay, &bx, &by);
-    for (int k = parent.jlo + 1; k <= parent.jhi; ++k) {
-      const auto ku = static_cast<std::size_t>(k);
-      if (side(ku, ax, ay) > 0) info.jlo = k;   // a surely in sector k or later
-      if (side(ku, bx, by) < 0) {               // b surely before sector k
-        info.jhi = k - 1;
-        break;
-      }
-    }
+    info.jlo = lastSurelyPast(ax, ay, kRayMargin * (std::fabs(ax) + std::fabs(ay)), parent.jlo,
+                              parent.jhi);
+    info.jhi = lastNotSurelyBefore(bx, by, kRayMargin * (std::fabs(bx) + std::fabs(by)), info.jlo,
+                                   parent.jhi);
     info.single = info.jlo == info.jhi;
     info.cls = rangeClass(x0, y0, x1, y1, info.jlo, info.jhi, false);
     return info;
@@ -372,7 +389,7 @@ struct PreparedScan {
     info.jlo = ilo;
     info.jhi = ihi;
     info.single = !partial && ilo == ihi;
-    info.narrow = !partial && narrow_ok && ihi - ilo <= kNarrowBeams;
+    info.narrow = !partial && static_cast<double>(ihi - ilo + 1) * inc < 0.5 * kPi;
     info.cls = rangeClass(x0, y0, x1, y1, ilo, ihi, partial);
     return info;
   }
@@ -437,7 +454,6 @@ ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& s
   ps->seam_map = std::remainder(ps->theta + ps->seam, kTwoPi);
   ps->inv_inc = 1.0 / ps->inc;
   ps->t_seam = (ps->seam - ps->amin) / ps->inc;
-  ps->narrow_ok = ps->inc * (kNarrowBeams + 1) < 0.5 * kPi;
   ps->bnd_x.resize(nu + 1);
   ps->bnd_y.resize(nu + 1);
   for (std::size_t k = 0; k <= nu; ++k) {
