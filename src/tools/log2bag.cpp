@@ -94,7 +94,7 @@ bool parseOptions(int argc, char** argv, Options* o) {
   while ((c = getopt_long(argc, argv, "h", longopts, nullptr)) != -1) {
     switch (c) {
       case kMax:
-        o->max_scans = std::stoul(optarg);
+        o->max_scans = static_cast<std::size_t>(wavog_tools::parseInteger("--max-scans", optarg, 0));
         break;
       case kStrict:
         o->strict = true;
@@ -110,19 +110,19 @@ bool parseOptions(int argc, char** argv, Options* o) {
         o->logger_stamp = std::string(optarg) == "logger";
         break;
       case kRate:
-        o->rate = std::stod(optarg);
+        o->rate = wavog_tools::parseNumber("--rate", optarg);
         break;
       case kEpoch:
-        o->epoch = std::stod(optarg);
+        o->epoch = wavog_tools::parseNumber("--epoch", optarg);
         break;
       case kRangeMin:
-        o->range_min = std::stod(optarg);
+        o->range_min = wavog_tools::parseNumber("--range-min", optarg);
         break;
       case kCompression:
         o->compression = optarg;
         break;
       case kPad:
-        o->pad = std::stod(optarg);
+        o->pad = wavog_tools::parseNumber("--pad", optarg);
         break;
       case kQuiet:
         o->quiet = true;

@@ -91,7 +91,9 @@ void usage(std::FILE* out) {
 
 std::vector<int> parseScales(const std::string& text) {
   std::vector<int> scales;
-  for (const auto& item : wavog_tools::splitList(text)) scales.push_back(std::stoi(item));
+  for (const auto& item : wavog_tools::splitList(text)) {
+    scales.push_back(static_cast<int>(wavog_tools::parseInteger("--scale", item.c_str(), 0)));
+  }
   if (scales.empty()) throw std::invalid_argument("--scale needs at least one scale");
   return scales;
 }
@@ -136,7 +138,7 @@ bool parseOptions(int argc, char** argv, Options* o) {
         o->policy = optarg;
         break;
       case kResolution:
-        o->resolution = std::stod(optarg);
+        o->resolution = wavog_tools::parseNumber("--resolution", optarg);
         break;
       case kScale:
         o->scales = parseScales(optarg);
@@ -145,7 +147,7 @@ bool parseOptions(int argc, char** argv, Options* o) {
         o->aggregation = optarg;
         break;
       case kMax:
-        o->max_scans = std::stoul(optarg);
+        o->max_scans = static_cast<std::size_t>(wavog_tools::parseInteger("--max-scans", optarg, 0));
         break;
       case kTopics:
         o->topics = wavog_tools::splitList(optarg);
@@ -154,7 +156,7 @@ bool parseOptions(int argc, char** argv, Options* o) {
         o->fixed_frame = wavog_tools::stripSlash(optarg);
         break;
       case kSnapshot:
-        o->snapshot_every = std::stod(optarg);
+        o->snapshot_every = wavog_tools::parseNumber("--snapshot-every", optarg);
         break;
       case kNoProgress:
         o->progress = false;

@@ -260,4 +260,15 @@ double parseNumber(const std::string& flag, const char* text) {
   return v;
 }
 
+long parseInteger(const std::string& flag, const char* text, long min_value) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(text, &end, 10);
+  if (errno || end == text || *end || v < min_value) {
+    throw std::invalid_argument(flag + ": not a whole number >= " + std::to_string(min_value) +
+                                ": '" + text + "'");
+  }
+  return v;
+}
+
 }  // namespace wavog_tools

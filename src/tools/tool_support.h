@@ -124,6 +124,9 @@ std::string stripSlash(const std::string& frame);
 /// A command-line number: the whole of `text` must be a finite number, else
 /// std::invalid_argument("<flag>: not a number: '<text>'").
 double parseNumber(const std::string& flag, const char* text);
+/// A command-line whole number >= min_value: std::invalid_argument("<flag>: not a whole number
+/// >= <min>: '<text>'") otherwise (trailing characters, fractions and overflow included).
+long parseInteger(const std::string& flag, const char* text, long min_value);
 
 }  // namespace wavog_tools
 

@@ -444,6 +444,14 @@ TEST(Offline, ClearErrors) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("policy"), std::string::npos) << r.err;
 
+  // Numbers are read whole: trailing characters are an error naming the option.
+  r = run(WAVOG_OFFLINE, "--no-progress --resolution 0.05x -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--resolution: not a number: '0.05x'"), std::string::npos) << r.err;
+  r = run(WAVOG_OFFLINE, "--no-progress --scale 0,2.5 -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--scale: not a whole number >= 0: '2.5'"), std::string::npos) << r.err;
+
   const std::string yaml = (workDir() / "bad.yaml").string();
   std::ofstream(yaml) << "resolution: [1, 2\n";
   r = run(WAVOG_OFFLINE, "--no-progress -c " + yaml + " -o " + out + " " + bag);

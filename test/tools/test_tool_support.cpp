@@ -1,10 +1,12 @@
 // Tests of the tools' shared pieces: pose algebra, time stamp repair, the CARMEN log plan.
 #include <gtest/gtest.h>
+
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 
 #include "tool_support.h"
@@ -108,6 +110,29 @@ TEST(TextHelpers, JsonAndLists) {
   EXPECT_EQ(wavog_tools::splitList(" a, b,,c "), (std::vector<std::string>{"a", "b", "c"}));
   EXPECT_EQ(wavog_tools::stripSlash("/laser"), "laser");
   EXPECT_EQ(wavog_tools::stripSlash("laser"), "laser");
+}
+
+TEST(TextHelpers, StrictNumbers) {
+  EXPECT_DOUBLE_EQ(wavog_tools::parseNumber("--rate", "0.25"), 0.25);
+  EXPECT_DOUBLE_EQ(wavog_tools::parseNumber("--epoch", "-3e2"), -300.0);
+  for (const char* bad : {"0.5x", "abc", "", "inf", "nan", "1e999", "2 "}) {
+    try {
+      wavog_tools::parseNumber("--rate", bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()), std::string("--rate: not a number: '") + bad + "'");
+    }
+  }
+  EXPECT_EQ(wavog_tools::parseInteger("--scale", "7", 0), 7);
+  EXPECT_EQ(wavog_tools::parseInteger("--scale", "0", 0), 0);
+  for (const char* bad : {"2.5", "-1", "3x", "", "99999999999999999999"}) {
+    try {
+      wavog_tools::parseInteger("--scale", bad, 0);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()), std::string("--scale: not a whole number >= 0: '") + bad + "'");
+    }
+  }
 }
 
 }  // namespace
