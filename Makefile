@@ -22,7 +22,7 @@ $(BUILD)/CMakeCache.txt: | deps
 build: deps $(BUILD)/CMakeCache.txt
 	@cmake --build $(BUILD) -j$(JOBS) -- --no-print-directory
 	@# catkin's gtest / rostest executables hang off its `tests` target, outside `all`.
-	@if cmake --build $(BUILD) --target help | grep -q '\.\.\. tests$$'; then \
+	@if cmake --build $(BUILD) --target help | grep '\.\.\. tests$$' >/dev/null; then \
 	  cmake --build $(BUILD) --target tests -j$(JOBS) -- --no-print-directory; fi
 
 ## Every test (core gtests and rostests); ends with "N passed, N failed".
@@ -33,7 +33,7 @@ test: build
 test-asan: deps
 	@mkdir -p $(BUILD_ASAN)
 	@cmake -S $(ROOT) -B $(BUILD_ASAN) -DCATKIN_DEVEL_PREFIX=$(BUILD_ASAN)/devel $(CMAKE_ARGS) \
-	  -DWAVOG_SANITIZE="address;undefined" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWAVOG_BUILD_ROS=OFF \
+	  -DWAVOG_SANITIZE="address;undefined;float-cast-overflow" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWAVOG_BUILD_ROS=OFF \
 	  >$(BUILD_ASAN)/configure.log || { cat $(BUILD_ASAN)/configure.log; exit 1; }
 	@cmake --build $(BUILD_ASAN) --target core_tests -j$(JOBS) -- --no-print-directory
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \

@@ -361,8 +361,10 @@ struct PreparedScan {
     auto beamRange = [&](double a_lo, double a_hi, long* jlo, long* jhi) {
       const double t_lo = (a_lo - kFastAtanError) * inv_inc + t_seam - 0.5 - kIndexSlack;
       const double t_hi = (a_hi + kFastAtanError) * inv_inc + t_seam + 0.5 + kIndexSlack;
-      *jlo = static_cast<long>(std::ceil(std::max(t_lo, -1.0)));
-      *jhi = static_cast<long>(std::floor(std::min(t_hi, static_cast<double>(n))));
+      // Clamped to [-1, n] both ways: with a tiny beam step t can exceed any integer type.
+      const double top = static_cast<double>(n);
+      *jlo = static_cast<long>(std::ceil(std::min(std::max(t_lo, -1.0), top)));
+      *jhi = static_cast<long>(std::floor(std::max(std::min(t_hi, top), -1.0)));
     };
     long jlo, jhi;
     beamRange(lo, hi, &jlo, &jhi);

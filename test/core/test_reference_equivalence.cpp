@@ -123,6 +123,17 @@ TEST(ReferenceEquivalence, DegenerateGeometry) {
     for (int j = 0; j < 16; ++j) s.ranges.push_back(j % 5 == 0 ? std::numeric_limits<float>::infinity() : 1.6f + 0.8f * static_cast<float>(j % 3));
     run.integrate(s);
   }
+  // Beam steps far below any cell's angular size (every bearing index overflows an integer).
+  for (double inc : {1e-300, -1e-12}) {
+    OwnedScan s;
+    s.pose = {0.05, 0.05, 0.3};
+    s.angle_min = 0.1;
+    s.angle_increment = inc;
+    s.range_min = 0.0;
+    s.range_max = 5.0;
+    s.ranges = {2.0f, 2.5f, std::numeric_limits<float>::infinity()};
+    run.integrate(s);
+  }
   run.expectEqual("degenerate");
   run.expectMultiscale(4);
 }
