@@ -3,9 +3,11 @@
 // Per scan: beams are classified per REP 117 into hit / clearing / invalid, with their E and U
 // limits zE, zU; sparse tables give min zE and max zU over any beam interval in O(1); hit cells
 // are binned. Per node: the node's range and bearing interval against those tables give U, E,
-// FREE_OR_UNKNOWN or MIXED without looping over beams (conservative: never E or U wrongly).
+// FREE_OR_UNKNOWN or MIXED without looping over beams (conservative: never E or U wrongly), and
+// the beams that may meet it, which its sub-squares and cells inherit (inside one sector: ranges
+// only; within under 90 deg of sectors: boundary rays by cross products, no bearings).
 // U is skipped, E is applied at the node's own scale (a lazy tag with forgetting), the rest
-// descends; finest cells are classified exactly like the dense reference does, cell by cell.
+// descends; finest cells get exactly the class the dense reference gives them, cell by cell.
 #include <algorithm>
 #include <array>
 #include <cmath>
