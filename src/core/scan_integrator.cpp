@@ -65,6 +65,11 @@ struct BoxInfo {
 // bearings and of the boundary directions).
 constexpr double kRayMargin = 1e-9;
 
+/// An axis-aligned square of the map frame, in metres.
+struct Square {
+  double x0, y0, x1, y1;
+};
+
 /// Everything about one scan that node and cell classification need. Reused between scans.
 struct PreparedScan {
   double px = 0, py = 0, theta = 0;  // sensor pose
@@ -119,40 +124,6 @@ struct PreparedScan {
     if (rho < ze[ju]) return CellClass::kEmpty;
     if (kind[ju] == kHit && rho <= zu[ju]) return CellClass::kOccupied;
     return CellClass::kUnknown;
-  }
-
-  /// Classes of the 4 cells of the 2x2 square at (ix0, iy0), in child order q = x + 2y.
-  void classifyQuad(std::int64_t ix0, std::int64_t iy0, const BoxInfo& box,
-                    std::array<CellClass, 4>* out) const {
-    if (!box.single) {
-      for (int q = 0; q < 4; ++q) {
-        (*out)[static_cast<std::size_t>(q)] = classifyCell(ix0 + (q & 1), iy0 + (q >> 1), box);
-      }
-      return;
-    }
-    // One sector for all four: the same tests as classifyCell, with shared loads.
-    const auto j = static_cast<std::size_t>(box.jlo);
-    const std::uint8_t k = kind[j];
-    const double e = ze[j], u = zu[j];
-    const double dx[2] = {(static_cast<double>(ix0) + 0.5) * res - px,
-                          (static_cast<double>(ix0 + 1) + 0.5) * res - px};
-    const double dy[2] = {(static_cast<double>(iy0) + 0.5) * res - py,
-                          (static_cast<double>(iy0 + 1) + 0.5) * res - py};
-    for (int q = 0; q < 4; ++q) {
-      const double ex = dx[q & 1], ey = dy[q >> 1];
-      const double rho = std::sqrt(ex * ex + ey * ey);
-      CellClass c = CellClass::kUnknown;
-      if (k == kInvalid) {
-        c = CellClass::kUnknown;
-      } else if (k == kHit && hit_x[j] == ix0 + (q & 1) && hit_y[j] == iy0 + (q >> 1)) {
-        c = CellClass::kOccupied;
-      } else if (rho < e) {
-        c = CellClass::kEmpty;
-      } else if (k == kHit && rho <= u) {
-        c = CellClass::kOccupied;
-      }
-      (*out)[static_cast<std::size_t>(q)] = c;
-    }
   }
 
   /// True if a hit endpoint lies in cell (ix, iy) of square `box` (only its beams can).
@@ -243,24 +214,44 @@ struct PreparedScan {
   /// distance is kept, as the reference compares it.
   static double sq(double z) { return z > 0.0 ? z * z : -1.0; }
 
+  /// Squared distance from the sensor to the nearest point of `sq` (0 when it holds the sensor).
+  double nearest2(const Square& sq) const {
+    const double nx = std::max(std::max(sq.x0 - px, 0.0), px - sq.x1);
+    const double ny = std::max(std::max(sq.y0 - py, 0.0), py - sq.y1);
+    return nx * nx + ny * ny;
+  }
+
+  /// Squared distance from the sensor to the farthest corner of `sq`.
+  double farthest2(const Square& sq) const {
+    const double fx = std::max(std::fabs(sq.x0 - px), std::fabs(sq.x1 - px));
+    const double fy = std::max(std::fabs(sq.y0 - py), std::fabs(sq.y1 - py));
+    return fx * fx + fy * fy;
+  }
+
+  /// The square of side 2^l cells at cell (ix0, iy0), in metres.
+  Square square(int l, std::int64_t ix0, std::int64_t iy0) const {
+    const double size = static_cast<double>(std::int64_t{1} << l) * res;
+    const double x0 = static_cast<double>(ix0) * res, y0 = static_cast<double>(iy0) * res;
+    return {x0, y0, x0 + size, y0 + size};
+  }
+
   /// Class of the square of side 2^l cells at cell (ix0, iy0) inside a square classified as
   /// `parent`: a sub-square of a single-beam square needs ranges only.
   BoxInfo classifyBox(int l, std::int64_t ix0, std::int64_t iy0, const BoxInfo& parent) const {
     if (parent.single) {
       BoxInfo info = parent;
-      info.cls = classifyInBeam(l, ix0, iy0, static_cast<std::size_t>(parent.jlo));
+      info.cls = classifyInBeam(l, ix0, iy0, parent.jlo);
       return info;
     }
     if (parent.narrow) return classifyInRange(l, ix0, iy0, parent);
     return classifyBox(l, ix0, iy0);
   }
 
-  /// Corners of the square [x0, x1] x [y0, y1] (not holding the sensor) that bound its bearing
-  /// interval, counter-clockwise first (a) and last (b), as offsets from the sensor. Which
-  /// corners they are follows from where the sensor lies: left / right / within in x, below /
-  /// above / within in y.
-  void extremeCorners(double x0, double y0, double x1, double y1, double* ax, double* ay,
-                      double* bx, double* by) const {
+  /// Corners of square `sq` (not holding the sensor) that bound its bearing interval, counter-
+  /// clockwise first (a) and last (b), as offsets from the sensor. Which corners they are follows
+  /// from where the sensor lies: left / right / within in x, below / above / within in y.
+  void extremeCorners(const Square& sq, double* ax, double* ay, double* bx, double* by) const {
+    const double x0 = sq.x0, y0 = sq.y0, x1 = sq.x1, y1 = sq.y1;
     if (px < x0) {
       if (py < y0) {
         *ax = x1, *ay = y0, *bx = x0, *by = y1;
@@ -289,31 +280,24 @@ struct PreparedScan {
   /// the last boundary its first corner is surely past to the last one its last corner may be
   /// past (conservative both ways).
   BoxInfo classifyInRange(int l, std::int64_t ix0, std::int64_t iy0, const BoxInfo& parent) const {
-    const double size = static_cast<double>(std::int64_t{1} << l) * res;
-    const double x0 = static_cast<double>(ix0) * res, y0 = static_cast<double>(iy0) * res;
-    const double x1 = x0 + size, y1 = y0 + size;
+    const Square sq = square(l, ix0, iy0);
     BoxInfo info = parent;
     double ax, ay, bx, by;
-    extremeCorners(x0, y0, x1, y1, &ax, &ay, &bx, &by);
+    extremeCorners(sq, &ax, &ay, &bx, &by);
     info.jlo = lastSurelyPast(ax, ay, kRayMargin * (std::fabs(ax) + std::fabs(ay)), parent.jlo,
                               parent.jhi);
     info.jhi = lastNotSurelyBefore(bx, by, kRayMargin * (std::fabs(bx) + std::fabs(by)), info.jlo,
                                    parent.jhi);
     info.single = info.jlo == info.jhi;
-    info.cls = rangeClass(x0, y0, x1, y1, info.jlo, info.jhi, false);
+    info.cls = rangeClass(sq, info.jlo, info.jhi, false);
     return info;
   }
 
-  /// Class of the square [x0, x1] x [y0, y1] whose cells lie in sectors jlo..jhi (`partial`: or
-  /// outside the fan), from its distance range against the beams' limits.
-  CellClass rangeClass(double x0, double y0, double x1, double y1, int jlo, int jhi,
-                       bool partial) const {
-    const double nx = std::max(std::max(x0 - px, 0.0), px - x1);
-    const double ny = std::max(std::max(y0 - py, 0.0), py - y1);
-    if (nx * nx + ny * ny > queryMax(jlo, jhi)) return CellClass::kUnknown;
-    const double fx = std::max(std::fabs(x0 - px), std::fabs(x1 - px));
-    const double fy = std::max(std::fabs(y0 - py), std::fabs(y1 - py));
-    if (fx * fx + fy * fy < queryMin(jlo, jhi)) {
+  /// Class of square `sq` whose cells lie in sectors jlo..jhi (`partial`: or outside the fan),
+  /// from its distance range against the beams' limits.
+  CellClass rangeClass(const Square& sq, int jlo, int jhi, bool partial) const {
+    if (nearest2(sq) > queryMax(jlo, jhi)) return CellClass::kUnknown;
+    if (farthest2(sq) < queryMin(jlo, jhi)) {
       const bool any_invalid = invalid_prefix[static_cast<std::size_t>(jhi) + 1] >
                                invalid_prefix[static_cast<std::size_t>(jlo)];
       return (partial || any_invalid) ? CellClass::kFreeOrUnknown : CellClass::kEmpty;
@@ -323,16 +307,12 @@ struct PreparedScan {
 
   /// Class of a square that lies in sector j (not holding the sensor). Only beam j can put a hit
   /// in it, so the class follows from its distance range against ze[j], zu[j].
-  CellClass classifyInBeam(int l, std::int64_t ix0, std::int64_t iy0, std::size_t j) const {
-    const double size = static_cast<double>(std::int64_t{1} << l) * res;
-    const double x0 = static_cast<double>(ix0) * res, y0 = static_cast<double>(iy0) * res;
-    const double x1 = x0 + size, y1 = y0 + size;
-    const double nx = std::max({x0 - px, 0.0, px - x1}), ny = std::max({y0 - py, 0.0, py - y1});
-    if (nx * nx + ny * ny > zu2[j]) return CellClass::kUnknown;  // also invalid beams (zu2 = -1)
-    const double fx = std::max(std::fabs(x0 - px), std::fabs(x1 - px));
-    const double fy = std::max(std::fabs(y0 - py), std::fabs(y1 - py));
-    if (fx * fx + fy * fy < ze2[j]) return CellClass::kEmpty;
-    return kind[j] == kClear ? CellClass::kFreeOrUnknown : CellClass::kMixed;
+  CellClass classifyInBeam(int l, std::int64_t ix0, std::int64_t iy0, int j) const {
+    const Square sq = square(l, ix0, iy0);
+    const auto ju = static_cast<std::size_t>(j);
+    if (nearest2(sq) > zu2[ju]) return CellClass::kUnknown;  // also invalid beams (zu2 = -1)
+    if (farthest2(sq) < ze2[ju]) return CellClass::kEmpty;
+    return kind[ju] == kClear ? CellClass::kFreeOrUnknown : CellClass::kMixed;
   }
 
   /// Class of the square of side 2^l cells at cell (ix0, iy0), conservative: kEmpty only if
@@ -341,18 +321,14 @@ struct PreparedScan {
     BoxInfo info;
     info.jlo = 0;
     info.jhi = n - 1;
-    const double size = static_cast<double>(std::int64_t{1} << l) * res;
-    const double x0 = static_cast<double>(ix0) * res, y0 = static_cast<double>(iy0) * res;
-    const double x1 = x0 + size, y1 = y0 + size;
-    const double nx = std::max(std::max(x0 - px, 0.0), px - x1);
-    const double ny = std::max(std::max(y0 - py, 0.0), py - y1);
-    if (nx == 0.0 && ny == 0.0) return info;  // holds the sensor (boundary included)
+    const Square sq = square(l, ix0, iy0);
+    if (px >= sq.x0 && px <= sq.x1 && py >= sq.y0 && py <= sq.y1) return info;  // holds the sensor
     info.cls = CellClass::kUnknown;
-    if (nx * nx + ny * ny > reach2) return info;
+    if (nearest2(sq) > reach2) return info;
 
     // Bearing interval of the square (convex, not holding the sensor: span < pi).
     double ax, ay, bx, by;
-    extremeCorners(x0, y0, x1, y1, &ax, &ay, &bx, &by);
+    extremeCorners(sq, &ax, &ay, &bx, &by);
     // Offsets past the seam, in [0, 2 pi); the square wraps the seam when the last is below the
     // first, and is then unwrapped.
     const double lo = offSeam(fastAtan2(ay, ax));
@@ -394,7 +370,7 @@ struct PreparedScan {
     info.jhi = ihi;
     info.single = !partial && ilo == ihi;
     info.narrow = !partial && static_cast<double>(ihi - ilo + 1) * inc < 0.5 * kPi;
-    info.cls = rangeClass(x0, y0, x1, y1, ilo, ihi, partial);
+    info.cls = rangeClass(sq, ilo, ihi, partial);
     return info;
   }
 
@@ -639,17 +615,16 @@ class Integrator {
     return foldChanges(n, delta);
   }
 
-  // A level-1 node: its children are finest cells, classified together.
+  // A level-1 node: its children are finest cells.
   double visitLeafParent(Node& n, const BoxInfo& box, std::int64_t ix0, std::int64_t iy0,
                          double s) {
     visited_ += 4;
-    std::array<CellClass, 4> cls;
-    ps_.classifyQuad(ix0, iy0, box, &cls);
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     for (std::size_t q = 0; q < 4; ++q) {
-      if (cls[q] == CellClass::kUnknown) continue;
-      delta[q] = applyPolicy<P>(pc_, cls[q], c[q]) - c[q];
+      const CellClass cls = ps_.classifyCell(ix0 + (q & 1), iy0 + (q >> 1), box);
+      if (cls == CellClass::kUnknown) continue;
+      delta[q] = applyPolicy<P>(pc_, cls, c[q]) - c[q];
       n.known_all = static_cast<std::uint8_t>(n.known_all | (1u << q));
       n.known_any = static_cast<std::uint8_t>(n.known_any | (1u << q));
     }

@@ -100,6 +100,23 @@ std::uint8_t paeth(int a, int b, int c) {
   return static_cast<std::uint8_t>(c);
 }
 
+/// PNG filter `type` 0..4 (none, sub, up, average, Paeth): the prediction of a byte from its left
+/// (a), upper (b) and upper-left (c) neighbours.
+int predict(int type, int a, int b, int c) {
+  switch (type) {
+    case 1:
+      return a;
+    case 2:
+      return b;
+    case 3:
+      return (a + b) / 2;
+    case 4:
+      return paeth(a, b, c);
+    default:
+      return 0;
+  }
+}
+
 /// Image row of raster row `ry` (rows are flipped so that +y is up in the picture).
 int imageRow(const Raster& raster, std::int64_t ry) {
   return static_cast<int>(raster.box.height() - 1 - ry);
@@ -197,23 +214,7 @@ void writePng(const std::string& path, const Image& image) {
         const int a = i >= bpp ? row[i - bpp] : 0;
         const int b = up ? up[i] : 0;
         const int c = (up && i >= bpp) ? up[i - bpp] : 0;
-        int predicted = 0;
-        switch (f) {
-          case 1:
-            predicted = a;
-            break;
-          case 2:
-            predicted = b;
-            break;
-          case 3:
-            predicted = (a + b) / 2;
-            break;
-          case 4:
-            predicted = paeth(a, b, c);
-            break;
-          default:
-            break;
-        }
+        const int predicted = predict(static_cast<int>(f), a, b, c);
         const auto residual = static_cast<std::uint8_t>((row[i] - predicted) & 0xff);
         candidates[f][i] = residual;
         cost += residual < 128 ? residual : 256 - residual;
@@ -319,6 +320,7 @@ Image readPng(const std::string& path) {
   const std::size_t bpp = static_cast<std::size_t>(image.channels);
   for (std::size_t y = 0; y < height; ++y) {
     const auto filter = static_cast<std::uint8_t>(raw[y * (stride + 1)]);
+    if (filter > 4) throw fail("bad filter type " + std::to_string(filter));
     const auto* in = reinterpret_cast<const std::uint8_t*>(raw.data()) + y * (stride + 1) + 1;
     std::uint8_t* out = image.pixels.data() + y * stride;
     const std::uint8_t* up = y > 0 ? out - stride : nullptr;
@@ -326,26 +328,7 @@ Image readPng(const std::string& path) {
       const int a = i >= bpp ? out[i - bpp] : 0;
       const int b = up ? up[i] : 0;
       const int c = (up && i >= bpp) ? up[i - bpp] : 0;
-      int predicted = 0;
-      switch (filter) {
-        case 0:
-          predicted = 0;
-          break;
-        case 1:
-          predicted = a;
-          break;
-        case 2:
-          predicted = b;
-          break;
-        case 3:
-          predicted = (a + b) / 2;
-          break;
-        case 4:
-          predicted = paeth(a, b, c);
-          break;
-        default:
-          throw fail("bad filter type " + std::to_string(filter));
-      }
+      const int predicted = predict(filter, a, b, c);
       out[i] = static_cast<std::uint8_t>((in[i] + predicted) & 0xff);
     }
   }

@@ -313,15 +313,10 @@ int run(const Options& o) {
 
 int main(int argc, char** argv) {
   Options options;
-  try {
-    if (!parseOptions(argc, argv, &options)) {
-      usage(stderr);
-      return 2;
-    }
-    ros::Time::init();
-    return run(options);
-  } catch (const std::exception& e) {
-    std::cerr << "wavog_log2bag: error: " << e.what() << "\n";
-    return 1;
-  }
+  return wavog_tools::toolMain(
+      "wavog_log2bag", [&] { return parseOptions(argc, argv, &options); }, usage,
+      [&] {
+        ros::Time::init();
+        return run(options);
+      });
 }

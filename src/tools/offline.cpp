@@ -712,15 +712,10 @@ int run(const Options& o) {
 
 int main(int argc, char** argv) {
   Options options;
-  try {
-    if (!parseOptions(argc, argv, &options)) {
-      usage(stderr);
-      return 2;
-    }
-    ros::Time::init();
-    return run(options);
-  } catch (const std::exception& e) {
-    std::cerr << "wavog_offline: error: " << e.what() << "\n";
-    return 1;
-  }
+  return wavog_tools::toolMain(
+      "wavog_offline", [&] { return parseOptions(argc, argv, &options); }, usage,
+      [&] {
+        ros::Time::init();
+        return run(options);
+      });
 }

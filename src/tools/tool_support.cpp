@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iomanip>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 
@@ -248,6 +249,20 @@ std::vector<std::string> splitList(const std::string& text) {
 
 std::string stripSlash(const std::string& frame) {
   return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
+}
+
+int toolMain(const char* name, const std::function<bool()>& parse, void (*usage)(std::FILE*),
+             const std::function<int()>& run) {
+  try {
+    if (!parse()) {
+      usage(stderr);
+      return 2;
+    }
+    return run();
+  } catch (const std::exception& e) {
+    std::cerr << name << ": error: " << e.what() << "\n";
+    return 1;
+  }
 }
 
 double parseNumber(const std::string& flag, const char* text) {

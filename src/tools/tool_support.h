@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -120,6 +121,11 @@ std::string jsonNumber(double v);
 std::vector<std::string> splitList(const std::string& text);
 /// Strips one leading '/' (tf2 rejects frame ids that start with one).
 std::string stripSlash(const std::string& frame);
+
+/// The main() of wavog_log2bag and wavog_offline: `parse` (false: `usage` on stderr, status 2),
+/// then `run`'s status; any exception prints "<name>: error: <what>" and gives status 1.
+int toolMain(const char* name, const std::function<bool()>& parse, void (*usage)(std::FILE*),
+             const std::function<int()>& run);
 
 /// A command-line number: the whole of `text` must be a finite number, else
 /// std::invalid_argument("<flag>: not a number: '<text>'").
