@@ -222,6 +222,34 @@ struct WaveletMap::Impl {
   void dropIfEmpty(std::int64_t bx, std::int64_t by);
 };
 
+// Hot helpers of the integration, inline so the shared library calls them without a PLT hop.
+
+inline detail::Node& WaveletMap::Impl::installChild(detail::Node& n, int q, const detail::Node& m) {
+  if (n.children == 0) n.children = pool.allocate();
+  n.child_mask = static_cast<std::uint8_t>(n.child_mask | (1u << q));
+  detail::Node& c = child(n, q);
+  c = m;
+  ++nodes;
+  return c;
+}
+
+inline void WaveletMap::Impl::flush(detail::Node& n) {
+  if (n.k == 0) return;
+  const float m = static_cast<float>(pow_a[n.k]);
+  for (float& d : n.d) d *= m;
+  if (n.children != 0) {
+    for (int q = 0; q < 4; ++q) {
+      if (hasChild(n, q)) addPending(child(n, q), n.k);
+    }
+  }
+  n.k = 0;
+}
+
+inline void WaveletMap::Impl::addPending(detail::Node& n, unsigned m) {
+  if (n.k + m > 255u) flush(n);
+  n.k = static_cast<std::uint8_t>(n.k + m);
+}
+
 }  // namespace wavog
 
 #endif  // WAVOG_MAPPING_SRC_CORE_MAP_IMPL_H_

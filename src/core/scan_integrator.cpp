@@ -31,6 +31,41 @@ constexpr double kIndexSlack = 1e-6;
 // Numerical floor of the "E update changes nothing" test (log-odds).
 constexpr double kUnchangedFloor = 1e-9;
 
+// floor / ceil without a libm call (x86-64's baseline has no rounding instruction). Magnitudes
+// of 2^52 and more are integers already; NaN goes to std::floor / std::ceil.
+inline double fastFloor(double v) {
+  if (!(std::fabs(v) < 4503599627370496.0)) return std::floor(v);
+  const auto t = static_cast<double>(static_cast<std::int64_t>(v));
+  return t > v ? t - 1.0 : t;
+}
+inline double fastCeil(double v) {
+  if (!(std::fabs(v) < 4503599627370496.0)) return std::ceil(v);
+  const auto t = static_cast<double>(static_cast<std::int64_t>(v));
+  return t < v ? t + 1.0 : t;
+}
+
+// Exact squared forms of the reference's leaf tests sqrt(d2) < ze and sqrt(d2) <= zu (sqrt is
+// correctly rounded, hence monotone): sqrt(d2) < z <=> d2 < sqrtBelow(z), and
+// sqrt(d2) <= z <=> d2 <= sqrtAtMost(z), for every d2 >= 0. A few nextafter steps per beam.
+inline double sqrtBelow(double z) {  // smallest t >= 0 with sqrt(t) >= z
+  const double inf = std::numeric_limits<double>::infinity();
+  if (!(z > 0.0)) return 0.0;
+  double t = z * z;
+  if (std::isinf(t)) return inf;
+  while (t > 0.0 && std::sqrt(std::nextafter(t, 0.0)) >= z) t = std::nextafter(t, 0.0);
+  while (std::sqrt(t) < z) t = std::nextafter(t, inf);
+  return t;
+}
+inline double sqrtAtMost(double z) {  // largest t with sqrt(t) <= z; -1 when none
+  const double inf = std::numeric_limits<double>::infinity();
+  if (!(z >= 0.0)) return -1.0;
+  double t = z * z;
+  if (std::isinf(t)) return inf;
+  while (std::sqrt(std::nextafter(t, inf)) <= z) t = std::nextafter(t, inf);
+  while (t > 0.0 && std::sqrt(t) > z) t = std::nextafter(t, 0.0);
+  return t;
+}
+
 enum BeamKind : std::uint8_t { kInvalid = 0, kHit = 1, kClear = 2 };
 
 // atan2 from an odd polynomial on [0, 1] (coefficients fitted for this project by reweighted
@@ -82,6 +117,7 @@ struct PreparedScan {
   std::vector<std::uint8_t> kind;
   std::vector<double> ze, zu;
   std::vector<double> ze2, zu2;        // sq(ze), sq(zu): squares of the limits (see sq() below)
+  std::vector<double> te2, tu2;        // sqrtBelow(ze), sqrtAtMost(zu): the leaf tests, squared
   double reach2 = 0;                   // sq(reach)
   std::vector<double> min_ze, max_zu;  // sparse tables of ze2, zu2, level-major, n per level
   std::vector<int> invalid_prefix;     // invalid_prefix[j] = #invalid beams in [0, j)
@@ -120,9 +156,9 @@ struct PreparedScan {
       ju = static_cast<std::size_t>(j);
     }
     if (kind[ju] == kInvalid) return CellClass::kUnknown;
-    const double rho = std::sqrt(dx * dx + dy * dy);
-    if (rho < ze[ju]) return CellClass::kEmpty;
-    if (kind[ju] == kHit && rho <= zu[ju]) return CellClass::kOccupied;
+    const double d2 = dx * dx + dy * dy;  // rho = sqrt(d2) in the reference
+    if (d2 < te2[ju]) return CellClass::kEmpty;
+    if (kind[ju] == kHit && d2 <= tu2[ju]) return CellClass::kOccupied;
     return CellClass::kUnknown;
   }
 
@@ -145,7 +181,7 @@ struct PreparedScan {
   long beamOf(double dx, double dy) const {
     const double off = offSeam(fastAtan2(dy, dx));
     const double u = off * inv_inc + t_seam + 0.5;  // lround(t) = floor(t + 1/2) off the halves
-    const double f = std::floor(u);
+    const double f = fastFloor(u);
     if (u - f > fast_guard && u - f < 1.0 - fast_guard && off > kFastAtanError &&
         off < kTwoPi - kFastAtanError) {
       return static_cast<long>(f);
@@ -162,11 +198,9 @@ struct PreparedScan {
     while (lo < hi) {
       const int mid = lo + (hi - lo + 1) / 2;
       const auto m = static_cast<std::size_t>(mid);
-      if (bnd_x[m] * dy - bnd_y[m] * dx > tol) {
-        lo = mid;
-      } else {
-        hi = mid - 1;
-      }
+      const bool past = bnd_x[m] * dy - bnd_y[m] * dx > tol;  // branch-free: a coin toss
+      lo = past ? mid : lo;
+      hi = past ? hi : mid - 1;
     }
     return lo;
   }
@@ -175,11 +209,9 @@ struct PreparedScan {
     while (lo < hi) {
       const int mid = lo + (hi - lo + 1) / 2;
       const auto m = static_cast<std::size_t>(mid);
-      if (bnd_x[m] * dy - bnd_y[m] * dx < -tol) {
-        hi = mid - 1;
-      } else {
-        lo = mid;
-      }
+      const bool before = bnd_x[m] * dy - bnd_y[m] * dx < -tol;
+      hi = before ? mid - 1 : hi;
+      lo = before ? lo : mid;
     }
     return lo;
   }
@@ -341,8 +373,8 @@ struct PreparedScan {
       const double t_hi = (a_hi + kFastAtanError) * inv_inc + t_seam + 0.5 + kIndexSlack;
       // Clamped to [-1, n] both ways: with a tiny beam step t can exceed any integer type.
       const double top = static_cast<double>(n);
-      *jlo = static_cast<long>(std::ceil(std::min(std::max(t_lo, -1.0), top)));
-      *jhi = static_cast<long>(std::floor(std::max(std::min(t_hi, top), -1.0)));
+      *jlo = static_cast<long>(fastCeil(std::min(std::max(t_lo, -1.0), top)));
+      *jhi = static_cast<long>(fastFloor(std::max(std::min(t_hi, top), -1.0)));
     };
     long jlo, jhi;
     beamRange(lo, hi, &jlo, &jhi);
@@ -480,9 +512,13 @@ ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& s
   ps->max_zu.resize(static_cast<std::size_t>(levels) * nu);
   ps->ze2.resize(nu);
   ps->zu2.resize(nu);
+  ps->te2.resize(nu);
+  ps->tu2.resize(nu);
   for (std::size_t j = 0; j < nu; ++j) {
     ps->ze2[j] = PreparedScan::sq(ps->ze[j]);
     ps->zu2[j] = PreparedScan::sq(ps->zu[j]);
+    ps->te2[j] = sqrtBelow(ps->ze[j]);
+    ps->tu2[j] = sqrtAtMost(ps->zu[j]);
   }
   ps->reach2 = PreparedScan::sq(ps->reach);
   std::copy(ps->ze2.begin(), ps->ze2.end(), ps->min_ze.begin());

@@ -41,15 +41,6 @@ void WaveletMap::Impl::configure() {
   }
 }
 
-Node& WaveletMap::Impl::installChild(Node& n, int q, const Node& m) {
-  if (n.children == 0) n.children = pool.allocate();
-  n.child_mask = static_cast<std::uint8_t>(n.child_mask | (1u << q));
-  Node& c = child(n, q);
-  c = m;
-  ++nodes;
-  return c;
-}
-
 void WaveletMap::Impl::freeSubtree(Node& n) {
   if (n.children == 0) return;
   for (int q = 0; q < 4; ++q) {
@@ -71,23 +62,6 @@ void WaveletMap::Impl::removeChild(Node& n, int q) {
     pool.release(n.children);
     n.children = 0;
   }
-}
-
-void WaveletMap::Impl::flush(Node& n) {
-  if (n.k == 0) return;
-  const float m = static_cast<float>(pow_a[n.k]);
-  for (float& d : n.d) d *= m;
-  if (n.children != 0) {
-    for (int q = 0; q < 4; ++q) {
-      if (hasChild(n, q)) addPending(child(n, q), n.k);
-    }
-  }
-  n.k = 0;
-}
-
-void WaveletMap::Impl::addPending(Node& n, unsigned m) {
-  if (n.k + m > 255u) flush(n);
-  n.k = static_cast<std::uint8_t>(n.k + m);
 }
 
 namespace {
