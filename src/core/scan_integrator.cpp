@@ -162,6 +162,90 @@ struct PreparedScan {
     return CellClass::kUnknown;
   }
 
+  /// True when the cells of square `box` lie in few sectors, known without bearings (single, or
+  /// narrow over at most kFewSectors): classify4x4() applies.
+  static constexpr int kFewSectors = 8;
+  static bool fewSectors(const BoxInfo& box) {
+    return box.single || (box.narrow && box.jhi - box.jlo < kFewSectors);
+  }
+
+  /// classifyCell() for the 16 cells of the 4 x 4 square at (ix0, iy0) classified as `box`
+  /// (fewSectors(box)), cell (x, y) at out[x + 4 y]. Distances and cross products are separable
+  /// over the grid's 4 columns and 4 rows, and the hits of the square's beams are gathered once.
+  void classify4x4(std::int64_t ix0, std::int64_t iy0, const BoxInfo& box,
+                   std::array<CellClass, 16>* out) const {
+    // The reference's arithmetic: dx = (ix + 1/2) res - px, d2 = dx dx + dy dy.
+    std::array<double, 4> dx, dy, dx2, dy2;
+    for (std::size_t i = 0; i < 4; ++i) {
+      dx[i] = (static_cast<double>(ix0 + static_cast<std::int64_t>(i)) + 0.5) * res - px;
+      dy[i] = (static_cast<double>(iy0 + static_cast<std::int64_t>(i)) + 0.5) * res - py;
+      dx2[i] = dx[i] * dx[i];
+      dy2[i] = dy[i] * dy[i];
+    }
+    std::uint32_t hit_mask = 0;  // bit x + 4 y: a hit endpoint of the square's beams in the cell
+    for (int j = box.jlo; j <= box.jhi; ++j) {
+      const auto ju = static_cast<std::size_t>(j);
+      if (kind[ju] != kHit) continue;
+      const std::int64_t hx = hit_x[ju] - ix0, hy = hit_y[ju] - iy0;
+      if (hx >= 0 && hx < 4 && hy >= 0 && hy < 4) hit_mask |= 1u << (hx + 4 * hy);
+    }
+    if (box.single) {  // one beam: distances alone
+      const auto ju = static_cast<std::size_t>(box.jlo);
+      const double te = kind[ju] == kInvalid ? -1.0 : te2[ju];
+      const double tu = kind[ju] == kHit ? tu2[ju] : -1.0;
+      for (std::size_t i = 0; i < 16; ++i) {
+        const double d2 = dx2[i & 3] + dy2[i >> 2];
+        (*out)[i] = ((hit_mask >> i) & 1u) != 0 ? CellClass::kOccupied
+                    : d2 < te                   ? CellClass::kEmpty
+                    : d2 <= tu                  ? CellClass::kOccupied
+                                                : CellClass::kUnknown;
+      }
+      return;
+    }
+    for (std::size_t i = 0; i < 16; ++i) {
+      if ((hit_mask >> i) & 1u) {
+        (*out)[i] = CellClass::kOccupied;
+        continue;
+      }
+      const std::size_t c = i & 3, r = i >> 2;
+      long j = box.jlo;
+      {
+        // The sector: past every boundary jlo+1..j and before the rest, each by more than the
+        // margin, as in beamIn(); anything else goes to the reference's rounding (beamOf).
+        const double tol = kRayMargin * (std::fabs(dx[c]) + std::fabs(dy[r]));
+        bool ok = true, before = false;
+        for (int k = box.jlo + 1; k <= box.jhi; ++k) {
+          const auto ku = static_cast<std::size_t>(k);
+          const double cross = bnd_x[ku] * dy[r] - bnd_y[ku] * dx[c];
+          if (cross > tol) {
+            ok = ok && !before;
+            ++j;
+          } else if (cross < -tol) {
+            before = true;
+          } else {
+            ok = false;
+          }
+        }
+        if (!ok) j = beamOf(dx[c], dy[r]);
+        if (j < 0 || j >= n) {
+          (*out)[i] = CellClass::kUnknown;
+          continue;
+        }
+      }
+      const auto ju = static_cast<std::size_t>(j);
+      const double d2 = dx2[c] + dy2[r];
+      CellClass k = CellClass::kUnknown;
+      if (kind[ju] != kInvalid) {
+        if (d2 < te2[ju]) {
+          k = CellClass::kEmpty;
+        } else if (kind[ju] == kHit && d2 <= tu2[ju]) {
+          k = CellClass::kOccupied;
+        }
+      }
+      (*out)[i] = k;
+    }
+  }
+
   /// True if a hit endpoint lies in cell (ix, iy) of square `box` (only its beams can).
   bool isHitCell(std::int64_t ix, std::int64_t iy, const BoxInfo& box) const {
     constexpr int kScanLimit = 8;
@@ -583,7 +667,17 @@ class Integrator {
   template <typename Install, typename Remove>
   double processSlot(Node* node, const BoxInfo& box, int l, std::int64_t ix0, std::int64_t iy0,
                      double s, bool* all, bool* any, Install install, Remove remove) {
-    switch (box.cls) {
+    return updateSlot(node, box.cls, s, all, any, install, remove,
+                      [&](Node& m) { return visitNode(m, box, l, ix0, iy0, s); });
+  }
+
+  // The rules of one slot of class `cls` (U skipped, E at the slot's own scale, the section 3.4
+  // skip); descend(m) updates the slot's node m (the stored one, or a temporary uniform one) when
+  // the slot must be refined, and returns the change of its average.
+  template <typename Install, typename Remove, typename Descend>
+  double updateSlot(Node* node, CellClass cls, double s, bool* all, bool* any, Install install,
+                    Remove remove, Descend descend) {
+    switch (cls) {
       case CellClass::kUnknown:
         return 0.0;
       case CellClass::kEmpty:
@@ -618,7 +712,7 @@ class Integrator {
     }
     Node tmp = WaveletMap::Impl::uniformSlot(*all, *any);
     Node& m = node ? *node : tmp;
-    const double ds = visitNode(m, box, l, ix0, iy0, s);
+    const double ds = descend(m);
     impl_.settleSlot(m, node != nullptr, all, any, install, remove);
     return ds;
   }
@@ -630,6 +724,7 @@ class Integrator {
     ++visited_;
     if (n.k != 0) impl_.flush(n);
     if (l == 1) return visitLeafParent(n, box, ix0, iy0, s);
+    if (l == 2 && ps_.fewSectors(box)) return visitLevel2(n, box, ix0, iy0, s);
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     const std::int64_t half = std::int64_t{1} << (l - 1);
@@ -654,17 +749,73 @@ class Integrator {
   // A level-1 node: its children are finest cells.
   double visitLeafParent(Node& n, const BoxInfo& box, std::int64_t ix0, std::int64_t iy0,
                          double s) {
+    std::array<CellClass, 4> cls;
+    for (std::size_t q = 0; q < 4; ++q) {
+      cls[q] = ps_.classifyCell(ix0 + static_cast<std::int64_t>(q & 1),
+                                iy0 + static_cast<std::int64_t>(q >> 1), box);
+    }
+    return updateCells(n, cls, s);
+  }
+
+  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), whose
+  // classes are `cls` (child order); returns the change of n's average.
+  double updateCells(Node& n, const std::array<CellClass, 4>& cls, double s) {
     visited_ += 4;
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     for (std::size_t q = 0; q < 4; ++q) {
-      const CellClass cls = ps_.classifyCell(ix0 + (q & 1), iy0 + (q >> 1), box);
-      if (cls == CellClass::kUnknown) continue;
-      delta[q] = applyPolicy<P>(pc_, cls, c[q]) - c[q];
+      if (cls[q] == CellClass::kUnknown) continue;
+      delta[q] = applyPolicy<P>(pc_, cls[q], c[q]) - c[q];
       n.known_all = static_cast<std::uint8_t>(n.known_all | (1u << q));
       n.known_any = static_cast<std::uint8_t>(n.known_any | (1u << q));
     }
     return foldChanges(n, delta);
+  }
+
+  // A level-2 node (4 x 4 finest cells, tag flushed): its 16 cells are classified together
+  // (cheaply when the square lies in one or a few sectors) and each level-1 child slot takes the
+  // class of its 4 cells, exactly, instead of a conservative square test of its own.
+  double visitLevel2(Node& n, const BoxInfo& box, std::int64_t ix0, std::int64_t iy0, double s) {
+    std::array<CellClass, 16> cells;  // cell (x, y) at x + 4 y
+    ps_.classify4x4(ix0, iy0, box, &cells);
+    const std::array<double, 4> c = haar::backward(s, n.d);
+    std::array<double, 4> delta{};
+    for (int q = 0; q < 4; ++q) {
+      ++visited_;
+      const auto qu = static_cast<std::size_t>(q);
+      const std::size_t base = static_cast<std::size_t>((q & 1) * 2 + (q >> 1) * 8);
+      const std::array<CellClass, 4> cc{cells[base], cells[base + 1], cells[base + 4],
+                                        cells[base + 5]};
+      const CellClass slot = slotClass(cc);
+      if (slot == CellClass::kUnknown) continue;
+      const auto bit = static_cast<std::uint8_t>(1u << q);
+      Node* ch = impl_.hasChild(n, q) ? &impl_.child(n, q) : nullptr;
+      bool all = (n.known_all & bit) != 0, any = (n.known_any & bit) != 0;
+      delta[qu] = updateSlot(
+          ch, slot, c[qu], &all, &any, [&](const Node& m) { impl_.installChild(n, q, m); },
+          [&]() { impl_.removeChild(n, q); },
+          [&](Node& m) {
+            ++visited_;
+            if (m.k != 0) impl_.flush(m);
+            return updateCells(m, cc, c[qu]);
+          });
+      detail::setBit(&n.known_all, bit, all);
+      detail::setBit(&n.known_any, bit, any);
+    }
+    return foldChanges(n, delta);
+  }
+
+  // The exact class of a 2 x 2 square from its cells' classes.
+  static CellClass slotClass(const std::array<CellClass, 4>& cc) {
+    int e = 0, u = 0;
+    for (CellClass k : cc) {
+      if (k == CellClass::kOccupied) return CellClass::kMixed;
+      e += k == CellClass::kEmpty ? 1 : 0;
+      u += k == CellClass::kUnknown ? 1 : 0;
+    }
+    if (u == 4) return CellClass::kUnknown;
+    if (e == 4) return CellClass::kEmpty;
+    return CellClass::kFreeOrUnknown;
   }
 
   // Folds the children's average changes into n's details (one forward Haar step); returns the
