@@ -92,8 +92,10 @@ struct BoxInfo {
   CellClass cls = CellClass::kMixed;
   int jlo = 0, jhi = -1;  ///< beams whose sector may hold a point of the square (a superset)
   bool single = false;    ///< every point of the square lies in sector jlo (jlo == jhi), in the fan
-  bool narrow = false;    ///< in the fan, and its sectors span under pi / 2: the sub-squares and
+  bool narrow = false;    ///< its directions and sectors span under pi / 2: the sub-squares and
                           ///< cells find theirs by testing the boundaries (no bearings)
+  int slo = 0, shi = -1;  ///< narrow: the sectors that may hold a point of the square, with -1 and
+                          ///< n standing for outside the fan, before boundary 0 / past boundary n
 };
 
 // Margin of the boundary-ray side tests, in radians (far above the rounding of the reference's
@@ -166,7 +168,7 @@ struct PreparedScan {
   /// narrow over at most kFewSectors): classify4x4() applies.
   static constexpr int kFewSectors = 8;
   static bool fewSectors(const BoxInfo& box) {
-    return box.single || (box.narrow && box.jhi - box.jlo < kFewSectors);
+    return box.single || (box.narrow && box.shi - box.slo < kFewSectors);
   }
 
   /// classifyCell() for the 16 cells of the 4 x 4 square at (ix0, iy0) classified as `box`
@@ -208,13 +210,13 @@ struct PreparedScan {
         continue;
       }
       const std::size_t c = i & 3, r = i >> 2;
-      long j = box.jlo;
+      long j = box.slo;
       {
-        // The sector: past every boundary jlo+1..j and before the rest, each by more than the
+        // The sector: past every boundary slo+1..j and before the rest, each by more than the
         // margin, as in beamIn(); anything else goes to the reference's rounding (beamOf).
         const double tol = kRayMargin * (std::fabs(dx[c]) + std::fabs(dy[r]));
         bool ok = true, before = false;
-        for (int k = box.jlo + 1; k <= box.jhi; ++k) {
+        for (int k = box.slo + 1; k <= box.shi; ++k) {
           const auto ku = static_cast<std::size_t>(k);
           const double cross = bnd_x[ku] * dy[r] - bnd_y[ku] * dx[c];
           if (cross > tol) {
@@ -304,8 +306,8 @@ struct PreparedScan {
   /// too close to the next one to tell (then the reference's rounding decides, via beamOf).
   long beamIn(double dx, double dy, const BoxInfo& box) const {
     const double tol = kRayMargin * (std::fabs(dx) + std::fabs(dy));
-    const int j = lastSurelyPast(dx, dy, tol, box.jlo, box.jhi);
-    if (j < box.jhi) {
+    const int j = lastSurelyPast(dx, dy, tol, box.slo, box.shi);
+    if (j < box.shi) {
       const auto m = static_cast<std::size_t>(j + 1);
       if (!(bnd_x[m] * dy - bnd_y[m] * dx < -tol)) return beamOf(dx, dy);
     }
@@ -400,12 +402,15 @@ struct PreparedScan {
     BoxInfo info = parent;
     double ax, ay, bx, by;
     extremeCorners(sq, &ax, &ay, &bx, &by);
-    info.jlo = lastSurelyPast(ax, ay, kRayMargin * (std::fabs(ax) + std::fabs(ay)), parent.jlo,
-                              parent.jhi);
-    info.jhi = lastNotSurelyBefore(bx, by, kRayMargin * (std::fabs(bx) + std::fabs(by)), info.jlo,
-                                   parent.jhi);
-    info.single = info.jlo == info.jhi;
-    info.cls = rangeClass(sq, info.jlo, info.jhi, false);
+    info.slo = lastSurelyPast(ax, ay, kRayMargin * (std::fabs(ax) + std::fabs(ay)), parent.slo,
+                              parent.shi);
+    info.shi = lastNotSurelyBefore(bx, by, kRayMargin * (std::fabs(bx) + std::fabs(by)), info.slo,
+                                   parent.shi);
+    info.jlo = std::max(info.slo, 0);
+    info.jhi = std::min(info.shi, n - 1);
+    const bool partial = info.slo < 0 || info.shi > n - 1;
+    info.single = !partial && info.jlo == info.jhi;
+    info.cls = info.jlo > info.jhi ? CellClass::kUnknown : rangeClass(sq, info.jlo, info.jhi, partial);
     return info;
   }
 
@@ -462,6 +467,7 @@ struct PreparedScan {
     };
     long jlo, jhi;
     beamRange(lo, hi, &jlo, &jhi);
+    const long slo = jlo, shi = jhi;  // in [-1, n]: -1 and n are the outside of the fan
     const bool partial = straddles || jlo < 0 || jhi > n - 1;
     jlo = std::max(jlo, 0L);
     jhi = std::min(jhi, static_cast<long>(n - 1));
@@ -485,7 +491,12 @@ struct PreparedScan {
     info.jlo = ilo;
     info.jhi = ihi;
     info.single = !partial && ilo == ihi;
-    info.narrow = !partial && static_cast<double>(ihi - ilo + 1) * inc < 0.5 * kPi;
+    // Narrow, also across an edge of the fan (not the seam): every point and every boundary
+    // between its sectors within pi / 2 of each other, so boundary side tests are monotone.
+    info.narrow = !straddles && static_cast<double>(shi - slo + 1) * inc < 0.5 * kPi &&
+                  (hi - lo) + inc < 0.5 * kPi;
+    info.slo = static_cast<int>(slo);
+    info.shi = static_cast<int>(shi);
     info.cls = rangeClass(sq, ilo, ihi, partial);
     return info;
   }
