@@ -204,12 +204,32 @@ struct PreparedScan {
       }
       return;
     }
+    // A few sectors. Where the distance alone decides (E in every sector of the square, or U in
+    // every one: outside sectors and invalid beams count as U), no sector is needed.
+    double te_min = box.slo < 0 || box.shi > n - 1 ? -1.0 : te2[static_cast<std::size_t>(box.jlo)];
+    double te_max = -1.0, tu_max = -1.0;
+    for (int j = box.jlo; j <= box.jhi; ++j) {
+      const auto ju = static_cast<std::size_t>(j);
+      const double te = kind[ju] == kInvalid ? -1.0 : te2[ju];
+      te_min = std::min(te_min, te);
+      te_max = std::max(te_max, te);
+      if (kind[ju] == kHit) tu_max = std::max(tu_max, tu2[ju]);
+    }
     for (std::size_t i = 0; i < 16; ++i) {
       if ((hit_mask >> i) & 1u) {
         (*out)[i] = CellClass::kOccupied;
         continue;
       }
       const std::size_t c = i & 3, r = i >> 2;
+      const double d2_all = dx2[c] + dy2[r];
+      if (d2_all < te_min) {
+        (*out)[i] = CellClass::kEmpty;
+        continue;
+      }
+      if (d2_all >= te_max && d2_all > tu_max) {
+        (*out)[i] = CellClass::kUnknown;
+        continue;
+      }
       long j = box.slo;
       {
         // The sector: past every boundary slo+1..j and before the rest, each by more than the
