@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -47,22 +48,36 @@ inline double fastCeil(double v) {
 // Exact squared forms of the reference's leaf tests sqrt(d2) < ze and sqrt(d2) <= zu (sqrt is
 // correctly rounded, hence monotone): sqrt(d2) < z <=> d2 < sqrtBelow(z), and
 // sqrt(d2) <= z <=> d2 <= sqrtAtMost(z), for every d2 >= 0. A few nextafter steps per beam.
+// Neighbours of a finite double t > 0 (the bit patterns of positive doubles are ordered).
+inline double nextUp(double t) {
+  std::uint64_t b;
+  std::memcpy(&b, &t, sizeof b);
+  ++b;
+  std::memcpy(&t, &b, sizeof b);
+  return t;
+}
+inline double nextDown(double t) {
+  std::uint64_t b;
+  std::memcpy(&b, &t, sizeof b);
+  --b;
+  std::memcpy(&t, &b, sizeof b);
+  return t;
+}
 inline double sqrtBelow(double z) {  // smallest t >= 0 with sqrt(t) >= z
-  const double inf = std::numeric_limits<double>::infinity();
   if (!(z > 0.0)) return 0.0;
   double t = z * z;
-  if (std::isinf(t)) return inf;
-  while (t > 0.0 && std::sqrt(std::nextafter(t, 0.0)) >= z) t = std::nextafter(t, 0.0);
-  while (std::sqrt(t) < z) t = std::nextafter(t, inf);
+  if (std::isinf(t)) return t;
+  while (t > 0.0 && std::sqrt(nextDown(t)) >= z) t = nextDown(t);
+  while (std::sqrt(t) < z) t = nextUp(t);
   return t;
 }
 inline double sqrtAtMost(double z) {  // largest t with sqrt(t) <= z; -1 when none
-  const double inf = std::numeric_limits<double>::infinity();
   if (!(z >= 0.0)) return -1.0;
   double t = z * z;
-  if (std::isinf(t)) return inf;
-  while (std::sqrt(std::nextafter(t, inf)) <= z) t = std::nextafter(t, inf);
-  while (t > 0.0 && std::sqrt(t) > z) t = std::nextafter(t, 0.0);
+  if (std::isinf(t)) return t;
+  if (t == 0.0) return 0.0;  // sqrt of the smallest subnormal exceeds any z whose square is 0
+  while (std::sqrt(nextUp(t)) <= z) t = nextUp(t);
+  while (t > 0.0 && std::sqrt(t) > z) t = nextDown(t);
   return t;
 }
 
