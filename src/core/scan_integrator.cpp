@@ -769,6 +769,8 @@ class Integrator {
                    double s) {
     ++visited_;
     if (n.k != 0) impl_.flush(n);
+    // The children are read after the (long) classification: fetch them meanwhile.
+    if (n.children != 0) impl_.pool.prefetch(n.children);
     if (l == 1) return visitLeafParent(n, box, ix0, iy0, s);
     if (l == 2 && ps_.fewSectors(box)) return visitLevel2(n, box, ix0, iy0, s);
     const std::array<double, 4> c = haar::backward(s, n.d);
