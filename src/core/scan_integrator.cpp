@@ -181,10 +181,13 @@ struct PreparedScan {
 
   /// True when the cells of square `box` lie in few sectors, known without bearings (single, or
   /// narrow over at most kFewSectors): classify4x4() applies.
-  static constexpr int kFewSectors = 8;
+  static constexpr int kFewSectors = 32;
   static bool fewSectors(const BoxInfo& box) {
     return box.single || (box.narrow && box.shi - box.slo < kFewSectors);
   }
+
+  /// Up to this many boundaries, classify4x4() tests each one; beyond, it bisects (beamIn).
+  static constexpr int kLinearSectors = 4;
 
   /// classifyCell() for the 16 cells of the 4 x 4 square at (ix0, iy0) classified as `box`
   /// (fewSectors(box)), cell (x, y) at out[x + 4 y]. Distances and cross products are separable
@@ -246,7 +249,13 @@ struct PreparedScan {
         continue;
       }
       long j = box.slo;
-      {
+      if (box.shi - box.slo > kLinearSectors) {
+        j = beamIn(dx[c], dy[r], box);
+        if (j < 0 || j >= n) {
+          (*out)[i] = CellClass::kUnknown;
+          continue;
+        }
+      } else {
         // The sector: past every boundary slo+1..j and before the rest, each by more than the
         // margin, as in beamIn(); anything else goes to the reference's rounding (beamOf).
         const double tol = kRayMargin * (std::fabs(dx[c]) + std::fabs(dy[r]));
