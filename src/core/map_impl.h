@@ -144,16 +144,16 @@ struct WaveletMap::Impl {
   explicit Impl(const MapParams& p);
 
   MapParams params;
-  int levels = 0;            ///< block_levels
-  double init = 0.0;         ///< prior log-odds of never-observed cells
-  double a = 1.0;            ///< 1 - gamma for "forget", else 1
+  int levels = 0;                 ///< block_levels
+  double init = 0.0;              ///< prior log-odds of never-observed cells
+  double a = 1.0;                 ///< 1 - gamma for "forget", else 1
   double prune_threshold = 1e-6;  ///< effective tau
-  int k_star = 256;          ///< pending count at which a fully-E subtree is negligible (<= 255)
+  int k_star = 256;  ///< pending count at which a fully-E subtree is negligible (<= 255)
   std::array<double, 256> pow_a{};  ///< a^k
 
   detail::NodePool pool;
   detail::BlockMap blocks;
-  std::size_t nodes = 0;     ///< live nodes (roots included)
+  std::size_t nodes = 0;  ///< live nodes (roots included)
   std::uint64_t nodes_visited_last = 0;
 
   /// Recomputes a, pow_a, k_star, init from params (policy changes).

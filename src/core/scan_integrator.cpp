@@ -95,7 +95,8 @@ inline double fastAtan2(double y, double x) {
   const double mx = std::max(ax, ay), mn = std::min(ax, ay);
   if (mx == 0.0) return 0.0;
   const double a = mn / mx, q = a * a;
-  double r = a * (kC[0] + q * (kC[1] + q * (kC[2] + q * (kC[3] + q * (kC[4] + q * (kC[5] + q * kC[6]))))));
+  double r =
+      a * (kC[0] + q * (kC[1] + q * (kC[2] + q * (kC[3] + q * (kC[4] + q * (kC[5] + q * kC[6]))))));
   if (ay > ax) r = 1.57079632679489661923 - r;
   if (x < 0) r = 3.14159265358979323846 - r;
   return y < 0 ? -r : r;
@@ -129,21 +130,21 @@ struct PreparedScan {
   double seam = 0;                   // bearings are normalised into [seam, seam + 2 pi)
   double res = 0;
   int n = 0;
-  double reach = 0;                  // max zU over beams
-  std::vector<float> ranges;         // work copy (reordered when inc < 0)
+  double reach = 0;           // max zU over beams
+  std::vector<float> ranges;  // work copy (reordered when inc < 0)
   std::vector<std::uint8_t> kind;
   std::vector<double> ze, zu;
-  std::vector<double> ze2, zu2;        // sq(ze), sq(zu): squares of the limits (see sq() below)
-  std::vector<double> te2, tu2;        // sqrtBelow(ze), sqrtAtMost(zu): the leaf tests, squared
-  double reach2 = 0;                   // sq(reach)
-  std::vector<double> min_ze, max_zu;  // sparse tables of ze2, zu2, level-major, n per level
-  std::vector<int> invalid_prefix;     // invalid_prefix[j] = #invalid beams in [0, j)
-  std::vector<std::uint64_t> hits;     // sorted cell keys of hit endpoints
+  std::vector<double> ze2, zu2;            // sq(ze), sq(zu): squares of the limits (see sq() below)
+  std::vector<double> te2, tu2;            // sqrtBelow(ze), sqrtAtMost(zu): the leaf tests, squared
+  double reach2 = 0;                       // sq(reach)
+  std::vector<double> min_ze, max_zu;      // sparse tables of ze2, zu2, level-major, n per level
+  std::vector<int> invalid_prefix;         // invalid_prefix[j] = #invalid beams in [0, j)
+  std::vector<std::uint64_t> hits;         // sorted cell keys of hit endpoints
   std::vector<std::int64_t> hit_x, hit_y;  // per beam: the cell of its endpoint (hit beams)
-  double fast_guard = 0;               // |t - (j + 1/2)| beyond which fastAtan2 gives lround(t)
-  double seam_map = 0;                 // theta + seam reduced to [-pi, pi): the seam, map frame
-  double inv_inc = 0, t_seam = 0;      // 1 / inc and (seam - amin) / inc
-  std::vector<double> bnd_x, bnd_y;    // boundary k between sectors k-1 and k: unit direction
+  double fast_guard = 0;                   // |t - (j + 1/2)| beyond which fastAtan2 gives lround(t)
+  double seam_map = 0;                     // theta + seam reduced to [-pi, pi): the seam, map frame
+  double inv_inc = 0, t_seam = 0;          // 1 / inc and (seam - amin) / inc
+  std::vector<double> bnd_x, bnd_y;        // boundary k between sectors k-1 and k: unit direction
 
   static std::uint64_t cellKey(std::int64_t ix, std::int64_t iy) {
     return (static_cast<std::uint64_t>(ix + (std::int64_t{1} << 31)) << 32) ^
@@ -454,7 +455,8 @@ struct PreparedScan {
     info.jhi = std::min(info.shi, n - 1);
     const bool partial = info.slo < 0 || info.shi > n - 1;
     info.single = !partial && info.jlo == info.jhi;
-    info.cls = info.jlo > info.jhi ? CellClass::kUnknown : rangeClass(sq, info.jlo, info.jhi, partial);
+    info.cls =
+        info.jlo > info.jhi ? CellClass::kUnknown : rangeClass(sq, info.jlo, info.jhi, partial);
     return info;
   }
 
@@ -588,8 +590,9 @@ ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& s
   const double amax = ps->amin + ps->inc * (n_beams - 1.0);
   ps->seam = 0.5 * (ps->amin + amax) - kPi;
 
-  const double sensor_max =
-      params.sensor.max_range > 0 ? std::min(params.sensor.max_range, scan.range_max) : scan.range_max;
+  const double sensor_max = params.sensor.max_range > 0
+                                ? std::min(params.sensor.max_range, scan.range_max)
+                                : scan.range_max;
   const double half_band =
       0.5 * (params.sensor.band_width > 0 ? params.sensor.band_width : params.grid.resolution);
   const double clear = params.sensor.no_return_clear;
@@ -709,8 +712,8 @@ class Integrator {
     Node* root = b.has_root ? &b.root : nullptr;
     bool all = b.known_all, any = b.known_any;
     b.s += processSlot(
-        root, box, L, ix0, iy0, b.s, &all, &any,
-        [&](const Node& m) { impl_.installRoot(&b, m); }, [&]() { impl_.removeRoot(&b); });
+        root, box, L, ix0, iy0, b.s, &all, &any, [&](const Node& m) { impl_.installRoot(&b, m); },
+        [&]() { impl_.removeRoot(&b); });
     b.known_all = all;
     b.known_any = any;
   }
@@ -947,10 +950,18 @@ IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& s
   }
   std::uint64_t visited = 0;
   switch (impl_->params.policy.type) {
-    case PolicyType::kNone: visited = integrateAll<PolicyType::kNone>(*impl_, ps, &st); break;
-    case PolicyType::kMax: visited = integrateAll<PolicyType::kMax>(*impl_, ps, &st); break;
-    case PolicyType::kClamp: visited = integrateAll<PolicyType::kClamp>(*impl_, ps, &st); break;
-    case PolicyType::kForget: visited = integrateAll<PolicyType::kForget>(*impl_, ps, &st); break;
+    case PolicyType::kNone:
+      visited = integrateAll<PolicyType::kNone>(*impl_, ps, &st);
+      break;
+    case PolicyType::kMax:
+      visited = integrateAll<PolicyType::kMax>(*impl_, ps, &st);
+      break;
+    case PolicyType::kClamp:
+      visited = integrateAll<PolicyType::kClamp>(*impl_, ps, &st);
+      break;
+    case PolicyType::kForget:
+      visited = integrateAll<PolicyType::kForget>(*impl_, ps, &st);
+      break;
     case PolicyType::kClampLower:
       visited = integrateAll<PolicyType::kClampLower>(*impl_, ps, &st);
       break;

@@ -124,8 +124,8 @@ namespace {
 // way, nothing written). Returns the cell's value and whether it was observed.
 std::pair<float, bool> lookup(const WaveletMap::Impl& impl, const CellIndex& cell) {
   const int levels = impl.levels;
-  const Block* b = impl.findBlock(detail::floorShift(cell.x, levels),
-                                  detail::floorShift(cell.y, levels));
+  const Block* b =
+      impl.findBlock(detail::floorShift(cell.x, levels), detail::floorShift(cell.y, levels));
   if (b == nullptr) return {static_cast<float>(impl.init), false};
   double s = b->s;
   if (!b->has_root) return {static_cast<float>(b->known_all ? s : impl.init), b->known_all};
@@ -249,8 +249,8 @@ void WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y
     Block& b = impl.blocks.at(key);
     const std::int64_t bx = detail::blockKeyX(key), by = detail::blockKeyY(key);
     const std::int64_t x0 = bx * size, y0 = by * size;
-    const bool inside = x0 >= box.x0 && x0 + size - 1 <= box.x1 && y0 >= box.y0 &&
-                        y0 + size - 1 <= box.y1;
+    const bool inside =
+        x0 >= box.x0 && x0 + size - 1 <= box.x1 && y0 >= box.y0 && y0 + size - 1 <= box.y1;
     if (inside) {
       if (b.has_root) impl.removeRoot(&b);
       impl.blocks.erase(key);
@@ -259,9 +259,9 @@ void WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y
     Node tmp = WaveletMap::Impl::uniformSlot(b.known_all, b.known_any);
     Node& m = b.has_root ? b.root : tmp;
     b.s += clearNode(impl, m, L, x0, y0, b.s, box);
-    impl.settleSlot(m, b.has_root, &b.known_all, &b.known_any,
-                    [&](const Node& kept) { impl.installRoot(&b, kept); },
-                    [&]() { impl.removeRoot(&b); });
+    impl.settleSlot(
+        m, b.has_root, &b.known_all, &b.known_any,
+        [&](const Node& kept) { impl.installRoot(&b, kept); }, [&]() { impl.removeRoot(&b); });
     impl.dropIfEmpty(bx, by);
   }
 }
