@@ -22,7 +22,8 @@ set_tests_properties(baseline_test_dense_grid PROPERTIES LABELS "baseline" TIMEO
 find_package(octomap QUIET)
 if(octomap_FOUND)
   add_executable(wavog_compare src/tools/compare.cpp)
-  target_link_libraries(wavog_compare PRIVATE wavog_core wavog_io wavog_baseline ${OCTOMAP_LIBRARIES})
+  target_link_libraries(wavog_compare PRIVATE wavog_core wavog_io wavog_baseline wavog_tool_support
+    ${OCTOMAP_LIBRARIES})
   target_include_directories(wavog_compare SYSTEM PRIVATE ${OCTOMAP_INCLUDE_DIRS})
   target_compile_options(wavog_compare PRIVATE ${WAVOG_WARNINGS})
   target_compile_definitions(wavog_compare PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
@@ -32,6 +33,15 @@ if(octomap_FOUND)
   # "compare"; not a timed test).
   add_test(NAME compare_smoke COMMAND wavog_compare --smoke --out ${CMAKE_BINARY_DIR}/compare_smoke)
   set_tests_properties(compare_smoke PROPERTIES LABELS "compare" TIMEOUT 120)
+  # A malformed number is an error naming the option, not a prefix read as the value.
+  add_test(NAME compare_bad_number COMMAND wavog_compare --resolutions 0.05x --smoke
+    --out ${CMAKE_BINARY_DIR}/compare_bad_number)
+  set_tests_properties(compare_bad_number PROPERTIES LABELS "compare" TIMEOUT 60
+    PASS_REGULAR_EXPRESSION "--resolutions: not a number: '0.05x'")
+  add_test(NAME compare_bad_integer COMMAND wavog_compare --reps 2x --smoke
+    --out ${CMAKE_BINARY_DIR}/compare_bad_integer)
+  set_tests_properties(compare_bad_integer PROPERTIES LABELS "compare" TIMEOUT 60
+    PASS_REGULAR_EXPRESSION "--reps: not a whole number >= 1: '2x'")
 else()
   message(STATUS "wavog_compare: OctoMap not found (apt install liboctomap-dev); not built")
 endif()

@@ -2,11 +2,6 @@
 # log -> maps, no roscore), with their tests (ctest label "tools"). Included when ROS is built.
 set(WAVOG_TOOLS_BIN_DIR ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 
-add_library(wavog_tool_support STATIC src/tools/tool_support.cpp)
-target_link_libraries(wavog_tool_support PUBLIC wavog_io wavog_core)
-target_include_directories(wavog_tool_support PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/src/tools)
-target_compile_options(wavog_tool_support PRIVATE ${WAVOG_WARNINGS})
-
 add_executable(wavog_log2bag src/tools/log2bag.cpp)
 target_include_directories(wavog_log2bag SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(wavog_log2bag PRIVATE wavog_tool_support ${catkin_LIBRARIES})

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "tool_support.h"
 #include "wavog_mapping/baseline/dense_grid.h"
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -895,29 +896,35 @@ int main(int argc, char** argv) {
         opt.workloads = splitList(value());
       } else if (a == "--resolutions") {
         opt.resolutions.clear();
-        for (const std::string& r : splitList(value())) opt.resolutions.push_back(std::stod(r));
+        for (const std::string& r : splitList(value())) {
+          opt.resolutions.push_back(wavog_tools::parseNumber(a, r.c_str()));
+        }
       } else if (a == "--reps") {
-        opt.reps = std::stoi(value());
+        opt.reps = static_cast<int>(wavog_tools::parseInteger(a, value().c_str(), 1));
       } else if (a == "--max-scans") {
-        opt.max_scans = std::stoul(value());
+        opt.max_scans = static_cast<std::size_t>(wavog_tools::parseInteger(a, value().c_str(), 0));
       } else if (a == "--stride") {
         for (const std::string& item : splitList(value())) {
           const std::size_t eq = item.find('=');
           const std::string key = item.substr(0, eq);
-          const std::size_t n = eq == std::string::npos ? 0 : std::stoul(item.substr(eq + 1));
+          const std::size_t n = eq == std::string::npos
+                                    ? 0
+                                    : static_cast<std::size_t>(wavog_tools::parseInteger(
+                                          a, item.substr(eq + 1).c_str(), 1));
           if (n == 0 || (key != "fr079" && key != "csail")) {
             throw std::invalid_argument("--stride takes fr079=N,csail=N with N >= 1");
           }
           (key == "fr079" ? opt.stride_fr079 : opt.stride_csail) = n;
         }
       } else if (a == "--timed-scans") {
-        opt.timed_scans = std::stoul(value());
+        opt.timed_scans =
+            static_cast<std::size_t>(wavog_tools::parseInteger(a, value().c_str(), 0));
       } else if (a == "--synthetic-steps") {
-        opt.synthetic_steps = std::stoi(value());
+        opt.synthetic_steps = static_cast<int>(wavog_tools::parseInteger(a, value().c_str(), 1));
       } else if (a == "--no-return-clear") {
-        opt.no_return_clear = std::stod(value());
+        opt.no_return_clear = wavog_tools::parseNumber(a, value().c_str());
       } else if (a == "--crop") {
-        opt.crop_cells = std::stoi(value());
+        opt.crop_cells = static_cast<int>(wavog_tools::parseInteger(a, value().c_str(), 1));
       } else if (a == "--data") {
         opt.data_dir = value();
       } else if (a == "--out") {
