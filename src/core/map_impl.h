@@ -63,13 +63,13 @@ class NodePool {
     --live_;
   }
   NodeGroup& group(std::uint32_t g) { return chunks_[g >> kChunkBits][g & kChunkMask]; }
+  const NodeGroup& group(std::uint32_t g) const { return chunks_[g >> kChunkBits][g & kChunkMask]; }
   /// Asks the CPU to fetch group g (at most two cache lines) ahead of its use.
   void prefetch(std::uint32_t g) const {
     const char* p = reinterpret_cast<const char*>(&group(g));
     __builtin_prefetch(p);
     __builtin_prefetch(p + sizeof(NodeGroup) - 1);
   }
-  const NodeGroup& group(std::uint32_t g) const { return chunks_[g >> kChunkBits][g & kChunkMask]; }
   std::size_t liveGroups() const { return live_; }
   /// Bytes of the live groups plus bookkeeping.
   std::size_t bytes() const { return live_ * sizeof(NodeGroup) + overhead(); }

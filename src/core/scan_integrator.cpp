@@ -48,21 +48,17 @@ inline double fastCeil(double v) {
 // Exact squared forms of the reference's leaf tests sqrt(d2) < ze and sqrt(d2) <= zu (sqrt is
 // correctly rounded, hence monotone): sqrt(d2) < z <=> d2 < sqrtBelow(z), and
 // sqrt(d2) <= z <=> d2 <= sqrtAtMost(z), for every d2 >= 0. A few nextafter steps per beam.
-// Neighbours of a finite double t > 0 (the bit patterns of positive doubles are ordered).
-inline double nextUp(double t) {
+// The neighbour of a finite double t >= 0 one step up (+1) or down (-1, t > 0): the bit
+// patterns of non-negative doubles are ordered like their values.
+inline double stepDouble(double t, int dir) {
   std::uint64_t b;
   std::memcpy(&b, &t, sizeof b);
-  ++b;
+  b = dir > 0 ? b + 1 : b - 1;
   std::memcpy(&t, &b, sizeof b);
   return t;
 }
-inline double nextDown(double t) {
-  std::uint64_t b;
-  std::memcpy(&b, &t, sizeof b);
-  --b;
-  std::memcpy(&t, &b, sizeof b);
-  return t;
-}
+inline double nextUp(double t) { return stepDouble(t, 1); }
+inline double nextDown(double t) { return stepDouble(t, -1); }
 inline double sqrtBelow(double z) {  // smallest t >= 0 with sqrt(t) >= z
   if (!(z > 0.0)) return 0.0;
   double t = z * z;
@@ -134,9 +130,10 @@ struct PreparedScan {
   std::vector<float> ranges;  // work copy (reordered when inc < 0)
   std::vector<std::uint8_t> kind;
   std::vector<double> ze, zu;
-  std::vector<double> ze2, zu2;            // sq(ze), sq(zu): squares of the limits (see sq() below)
-  std::vector<double> te2, tu2;            // sqrtBelow(ze), sqrtAtMost(zu): the leaf tests, squared
-  double reach2 = 0;                       // sq(reach)
+  std::vector<double> ze2, zu2;  // sq(ze), sq(zu): squares of the limits (see sq() below)
+  std::vector<double> te2, tu2;  // leaf tests on d2 = rho^2 (cellAt): sqrtBelow(ze) (-1: invalid),
+                                 // sqrtAtMost(zu) (-1: not a hit, so never O)
+  double reach2 = 0;             // sq(reach)
   std::vector<double> min_ze, max_zu;      // sparse tables of ze2, zu2, level-major, n per level
   std::vector<int> invalid_prefix;         // invalid_prefix[j] = #invalid beams in [0, j)
   std::vector<std::uint64_t> hits;         // sorted cell keys of hit endpoints
@@ -173,11 +170,15 @@ struct PreparedScan {
       if (j < 0 || j >= n) return CellClass::kUnknown;
       ju = static_cast<std::size_t>(j);
     }
-    if (kind[ju] == kInvalid) return CellClass::kUnknown;
-    const double d2 = dx * dx + dy * dy;  // rho = sqrt(d2) in the reference
-    if (d2 < te2[ju]) return CellClass::kEmpty;
-    if (kind[ju] == kHit && d2 <= tu2[ju]) return CellClass::kOccupied;
-    return CellClass::kUnknown;
+    return cellAt(ju, dx * dx + dy * dy);
+  }
+
+  /// The sector model's class of a cell (not holding a hit) in sector j whose centre lies at
+  /// squared distance d2: the reference's sqrt(d2) < ze (E), else hit and sqrt(d2) <= zu (O).
+  CellClass cellAt(std::size_t j, double d2) const {
+    return d2 < te2[j]    ? CellClass::kEmpty
+           : d2 <= tu2[j] ? CellClass::kOccupied
+                          : CellClass::kUnknown;
   }
 
   /// True when the cells of square `box` lie in few sectors, known without bearings (single, or
@@ -187,7 +188,7 @@ struct PreparedScan {
     return box.single || (box.narrow && box.shi - box.slo < kFewSectors);
   }
 
-  /// Up to this many boundaries, classify4x4() tests each one; beyond, it bisects (beamIn).
+  /// Up to this many boundaries, beamIn() tests each one; beyond, it bisects.
   static constexpr int kLinearSectors = 4;
 
   /// classifyCell() for the 16 cells of the 4 x 4 square at (ix0, iy0) classified as `box`
@@ -212,27 +213,21 @@ struct PreparedScan {
     }
     if (box.single) {  // one beam: distances alone
       const auto ju = static_cast<std::size_t>(box.jlo);
-      const double te = kind[ju] == kInvalid ? -1.0 : te2[ju];
-      const double tu = kind[ju] == kHit ? tu2[ju] : -1.0;
       for (std::size_t i = 0; i < 16; ++i) {
-        const double d2 = dx2[i & 3] + dy2[i >> 2];
         (*out)[i] = ((hit_mask >> i) & 1u) != 0 ? CellClass::kOccupied
-                    : d2 < te                   ? CellClass::kEmpty
-                    : d2 <= tu                  ? CellClass::kOccupied
-                                                : CellClass::kUnknown;
+                                                : cellAt(ju, dx2[i & 3] + dy2[i >> 2]);
       }
       return;
     }
     // A few sectors. Where the distance alone decides (E in every sector of the square, or U in
     // every one: outside sectors and invalid beams count as U), no sector is needed.
-    double te_min = box.slo < 0 || box.shi > n - 1 ? -1.0 : te2[static_cast<std::size_t>(box.jlo)];
+    double te_min = box.slo < 0 || box.shi > n - 1 ? -1.0 : std::numeric_limits<double>::infinity();
     double te_max = -1.0, tu_max = -1.0;
     for (int j = box.jlo; j <= box.jhi; ++j) {
       const auto ju = static_cast<std::size_t>(j);
-      const double te = kind[ju] == kInvalid ? -1.0 : te2[ju];
-      te_min = std::min(te_min, te);
-      te_max = std::max(te_max, te);
-      if (kind[ju] == kHit) tu_max = std::max(tu_max, tu2[ju]);
+      te_min = std::min(te_min, te2[ju]);
+      te_max = std::max(te_max, te2[ju]);
+      tu_max = std::max(tu_max, tu2[ju]);
     }
     for (std::size_t i = 0; i < 16; ++i) {
       if ((hit_mask >> i) & 1u) {
@@ -240,56 +235,21 @@ struct PreparedScan {
         continue;
       }
       const std::size_t c = i & 3, r = i >> 2;
-      const double d2_all = dx2[c] + dy2[r];
-      if (d2_all < te_min) {
+      const double d2 = dx2[c] + dy2[r];
+      if (d2 < te_min) {
         (*out)[i] = CellClass::kEmpty;
         continue;
       }
-      if (d2_all >= te_max && d2_all > tu_max) {
+      if (d2 >= te_max && d2 > tu_max) {
         (*out)[i] = CellClass::kUnknown;
         continue;
       }
-      long j = box.slo;
-      if (box.shi - box.slo > kLinearSectors) {
-        j = beamIn(dx[c], dy[r], box);
-        if (j < 0 || j >= n) {
-          (*out)[i] = CellClass::kUnknown;
-          continue;
-        }
-      } else {
-        // The sector: past every boundary slo+1..j and before the rest, each by more than the
-        // margin, as in beamIn(); anything else goes to the reference's rounding (beamOf).
-        const double tol = kRayMargin * (std::fabs(dx[c]) + std::fabs(dy[r]));
-        bool ok = true, before = false;
-        for (int k = box.slo + 1; k <= box.shi; ++k) {
-          const auto ku = static_cast<std::size_t>(k);
-          const double cross = bnd_x[ku] * dy[r] - bnd_y[ku] * dx[c];
-          if (cross > tol) {
-            ok = ok && !before;
-            ++j;
-          } else if (cross < -tol) {
-            before = true;
-          } else {
-            ok = false;
-          }
-        }
-        if (!ok) j = beamOf(dx[c], dy[r]);
-        if (j < 0 || j >= n) {
-          (*out)[i] = CellClass::kUnknown;
-          continue;
-        }
+      const long j = beamIn(dx[c], dy[r], box);
+      if (j < 0 || j >= n) {
+        (*out)[i] = CellClass::kUnknown;
+        continue;
       }
-      const auto ju = static_cast<std::size_t>(j);
-      const double d2 = dx2[c] + dy2[r];
-      CellClass k = CellClass::kUnknown;
-      if (kind[ju] != kInvalid) {
-        if (d2 < te2[ju]) {
-          k = CellClass::kEmpty;
-        } else if (kind[ju] == kHit && d2 <= tu2[ju]) {
-          k = CellClass::kOccupied;
-        }
-      }
-      (*out)[i] = k;
+      (*out)[i] = cellAt(static_cast<std::size_t>(j), d2);
     }
   }
 
@@ -348,9 +308,28 @@ struct PreparedScan {
   }
 
   /// beamOf() for a cell of a narrow square: the last boundary it is surely past, unless it is
-  /// too close to the next one to tell (then the reference's rounding decides, via beamOf).
+  /// too close to the next one to tell (then the reference's rounding decides, via beamOf). Up to
+  /// kLinearSectors boundaries each one is tested (past the first j - slo of them, before the
+  /// rest); beyond, they are bisected.
   long beamIn(double dx, double dy, const BoxInfo& box) const {
     const double tol = kRayMargin * (std::fabs(dx) + std::fabs(dy));
+    if (box.shi - box.slo <= kLinearSectors) {
+      long j = box.slo;
+      bool ok = true, before = false;
+      for (int k = box.slo + 1; k <= box.shi; ++k) {
+        const auto ku = static_cast<std::size_t>(k);
+        const double cross = bnd_x[ku] * dy - bnd_y[ku] * dx;
+        if (cross > tol) {
+          ok = ok && !before;
+          ++j;
+        } else if (cross < -tol) {
+          before = true;
+        } else {
+          ok = false;
+        }
+      }
+      return ok ? j : beamOf(dx, dy);
+    }
     const int j = lastSurelyPast(dx, dy, tol, box.slo, box.shi);
     if (j < box.shi) {
       const auto m = static_cast<std::size_t>(j + 1);
@@ -659,8 +638,8 @@ ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& s
   for (std::size_t j = 0; j < nu; ++j) {
     ps->ze2[j] = PreparedScan::sq(ps->ze[j]);
     ps->zu2[j] = PreparedScan::sq(ps->zu[j]);
-    ps->te2[j] = sqrtBelow(ps->ze[j]);
-    ps->tu2[j] = sqrtAtMost(ps->zu[j]);
+    ps->te2[j] = ps->kind[j] == kInvalid ? -1.0 : sqrtBelow(ps->ze[j]);
+    ps->tu2[j] = ps->kind[j] == kHit ? sqrtAtMost(ps->zu[j]) : -1.0;
   }
   ps->reach2 = PreparedScan::sq(ps->reach);
   std::copy(ps->ze2.begin(), ps->ze2.end(), ps->min_ze.begin());
