@@ -114,6 +114,11 @@ struct BoxInfo {
 // bearings and of the boundary directions).
 constexpr double kRayMargin = 1e-9;
 
+/// Classes of a group of finest cells as bit masks (one bit per cell): E, O, and U for neither.
+struct CellMasks {
+  std::uint32_t e = 0, o = 0;
+};
+
 /// An axis-aligned square of the map frame, in metres.
 struct Square {
   double x0, y0, x1, y1;
@@ -192,10 +197,10 @@ struct PreparedScan {
   static constexpr int kLinearSectors = 4;
 
   /// classifyCell() for the 16 cells of the 4 x 4 square at (ix0, iy0) classified as `box`
-  /// (fewSectors(box)), cell (x, y) at out[x + 4 y]. Distances and cross products are separable
-  /// over the grid's 4 columns and 4 rows, and the hits of the square's beams are gathered once.
-  void classify4x4(std::int64_t ix0, std::int64_t iy0, const BoxInfo& box,
-                   std::array<CellClass, 16>* out) const {
+  /// (fewSectors(box)), as masks (bit x + 4 y for cell (x, y)). Distances and cross products are
+  /// separable over the grid's 4 columns and 4 rows, and the hits of the square's beams are
+  /// gathered once.
+  CellMasks classify4x4(std::int64_t ix0, std::int64_t iy0, const BoxInfo& box) const {
     // The reference's arithmetic: dx = (ix + 1/2) res - px, d2 = dx dx + dy dy.
     std::array<double, 4> dx, dy, dx2, dy2;
     for (std::size_t i = 0; i < 4; ++i) {
@@ -204,20 +209,26 @@ struct PreparedScan {
       dx2[i] = dx[i] * dx[i];
       dy2[i] = dy[i] * dy[i];
     }
-    std::uint32_t hit_mask = 0;  // bit x + 4 y: a hit endpoint of the square's beams in the cell
+    std::uint32_t hit = 0;  // a hit endpoint of the square's beams in the cell
     for (int j = box.jlo; j <= box.jhi; ++j) {
       const auto ju = static_cast<std::size_t>(j);
       if (kind[ju] != kHit) continue;
       const std::int64_t hx = hit_x[ju] - ix0, hy = hit_y[ju] - iy0;
-      if (hx >= 0 && hx < 4 && hy >= 0 && hy < 4) hit_mask |= 1u << (hx + 4 * hy);
+      if (hx >= 0 && hx < 4 && hy >= 0 && hy < 4) hit |= 1u << (hx + 4 * hy);
     }
+    CellMasks m;
     if (box.single) {  // one beam: distances alone
       const auto ju = static_cast<std::size_t>(box.jlo);
-      for (std::size_t i = 0; i < 16; ++i) {
-        (*out)[i] = ((hit_mask >> i) & 1u) != 0 ? CellClass::kOccupied
-                                                : cellAt(ju, dx2[i & 3] + dy2[i >> 2]);
+      const double te = te2[ju], tu = tu2[ju];
+      std::uint32_t e = 0, o = 0;
+      for (unsigned i = 0; i < 16; ++i) {
+        const double d2 = dx2[i & 3] + dy2[i >> 2];
+        e |= static_cast<std::uint32_t>(d2 < te) << i;
+        o |= static_cast<std::uint32_t>(d2 <= tu) << i;
       }
-      return;
+      m.e = e & ~hit;
+      m.o = (o & ~e) | hit;
+      return m;
     }
     // A few sectors. Where the distance alone decides (E in every sector of the square, or U in
     // every one: outside sectors and invalid beams count as U), no sector is needed.
@@ -229,28 +240,23 @@ struct PreparedScan {
       te_max = std::max(te_max, te2[ju]);
       tu_max = std::max(tu_max, tu2[ju]);
     }
-    for (std::size_t i = 0; i < 16; ++i) {
-      if ((hit_mask >> i) & 1u) {
-        (*out)[i] = CellClass::kOccupied;
-        continue;
-      }
-      const std::size_t c = i & 3, r = i >> 2;
+    m.o = hit;
+    for (unsigned i = 0; i < 16; ++i) {
+      if ((hit >> i) & 1u) continue;
+      const unsigned c = i & 3, r = i >> 2;
       const double d2 = dx2[c] + dy2[r];
       if (d2 < te_min) {
-        (*out)[i] = CellClass::kEmpty;
+        m.e |= 1u << i;
         continue;
       }
-      if (d2 >= te_max && d2 > tu_max) {
-        (*out)[i] = CellClass::kUnknown;
-        continue;
-      }
+      if (d2 >= te_max && d2 > tu_max) continue;  // U
       const long j = beamIn(dx[c], dy[r], box);
-      if (j < 0 || j >= n) {
-        (*out)[i] = CellClass::kUnknown;
-        continue;
-      }
-      (*out)[i] = cellAt(static_cast<std::size_t>(j), d2);
+      if (j < 0 || j >= n) continue;  // outside the fan: U
+      const CellClass cls = cellAt(static_cast<std::size_t>(j), d2);
+      m.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << i;
+      m.o |= static_cast<std::uint32_t>(cls == CellClass::kOccupied) << i;
     }
+    return m;
   }
 
   /// True if a hit endpoint lies in cell (ix, iy) of square `box` (only its beams can).
@@ -788,26 +794,32 @@ class Integrator {
   // A level-1 node: its children are finest cells.
   double visitLeafParent(Node& n, const BoxInfo& box, std::int64_t ix0, std::int64_t iy0,
                          double s) {
-    std::array<CellClass, 4> cls;
-    for (std::size_t q = 0; q < 4; ++q) {
-      cls[q] = ps_.classifyCell(ix0 + static_cast<std::int64_t>(q & 1),
-                                iy0 + static_cast<std::int64_t>(q >> 1), box);
+    CellMasks cells;
+    for (unsigned q = 0; q < 4; ++q) {
+      const CellClass cls = ps_.classifyCell(ix0 + static_cast<std::int64_t>(q & 1),
+                                             iy0 + static_cast<std::int64_t>(q >> 1), box);
+      cells.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << q;
+      cells.o |= static_cast<std::uint32_t>(cls == CellClass::kOccupied) << q;
     }
-    return updateCells(n, cls, s);
+    return updateCells(n, cells, s);
   }
 
-  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), whose
-  // classes are `cls` (child order); returns the change of n's average.
-  double updateCells(Node& n, const std::array<CellClass, 4>& cls, double s) {
+  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), cell q
+  // E or O by bit q of `cells` (U when in neither); returns the change of n's average.
+  double updateCells(Node& n, const CellMasks& cells, double s) {
     visited_ += 4;
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     for (std::size_t q = 0; q < 4; ++q) {
-      if (cls[q] == CellClass::kUnknown) continue;
-      delta[q] = applyPolicy<P>(pc_, cls[q], c[q]) - c[q];
-      n.known_all = static_cast<std::uint8_t>(n.known_all | (1u << q));
-      n.known_any = static_cast<std::uint8_t>(n.known_any | (1u << q));
+      if ((cells.e >> q) & 1u) {
+        delta[q] = applyPolicy<P>(pc_, CellClass::kEmpty, c[q]) - c[q];
+      } else if ((cells.o >> q) & 1u) {
+        delta[q] = applyPolicy<P>(pc_, CellClass::kOccupied, c[q]) - c[q];
+      }
     }
+    const auto known = static_cast<std::uint8_t>(cells.e | cells.o);
+    n.known_all = static_cast<std::uint8_t>(n.known_all | known);
+    n.known_any = static_cast<std::uint8_t>(n.known_any | known);
     return foldChanges(n, delta);
   }
 
@@ -815,16 +827,15 @@ class Integrator {
   // (cheaply when the square lies in one or a few sectors) and each level-1 child slot takes the
   // class of its 4 cells, exactly, instead of a conservative square test of its own.
   double visitLevel2(Node& n, const BoxInfo& box, std::int64_t ix0, std::int64_t iy0, double s) {
-    std::array<CellClass, 16> cells;  // cell (x, y) at x + 4 y
-    ps_.classify4x4(ix0, iy0, box, &cells);
+    const CellMasks cells = ps_.classify4x4(ix0, iy0, box);  // cell (x, y) at bit x + 4 y
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     for (int q = 0; q < 4; ++q) {
       ++visited_;
       const auto qu = static_cast<std::size_t>(q);
-      const std::size_t base = static_cast<std::size_t>((q & 1) * 2 + (q >> 1) * 8);
-      const std::array<CellClass, 4> cc{cells[base], cells[base + 1], cells[base + 4],
-                                        cells[base + 5]};
+      // The slot's cells (x, y), x, y in {0, 1}, as bits x + 2 y.
+      const unsigned shift = static_cast<unsigned>((q & 1) * 2 + (q >> 1) * 8);
+      const CellMasks cc{quad(cells.e >> shift), quad(cells.o >> shift)};
       const CellClass slot = slotClass(cc);
       if (slot == CellClass::kUnknown) continue;
       const auto bit = static_cast<std::uint8_t>(1u << q);
@@ -844,17 +855,14 @@ class Integrator {
     return foldChanges(n, delta);
   }
 
+  // Bits 0, 1, 4, 5 of a 4 x 4 mask (a 2 x 2 corner) as bits 0..3.
+  static std::uint32_t quad(std::uint32_t bits) { return (bits & 3u) | ((bits >> 2) & 0xCu); }
+
   // The exact class of a 2 x 2 square from its cells' classes.
-  static CellClass slotClass(const std::array<CellClass, 4>& cc) {
-    int e = 0, u = 0;
-    for (CellClass k : cc) {
-      if (k == CellClass::kOccupied) return CellClass::kMixed;
-      e += k == CellClass::kEmpty ? 1 : 0;
-      u += k == CellClass::kUnknown ? 1 : 0;
-    }
-    if (u == 4) return CellClass::kUnknown;
-    if (e == 4) return CellClass::kEmpty;
-    return CellClass::kFreeOrUnknown;
+  static CellClass slotClass(const CellMasks& cc) {
+    if (cc.o != 0) return CellClass::kMixed;
+    if (cc.e == 0xFu) return CellClass::kEmpty;
+    return cc.e == 0 ? CellClass::kUnknown : CellClass::kFreeOrUnknown;
   }
 
   // Folds the children's average changes into n's details (one forward Haar step); returns the
