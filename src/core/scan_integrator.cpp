@@ -241,6 +241,19 @@ struct PreparedScan {
       tu_max = std::max(tu_max, tu2[ju]);
     }
     m.o = hit;
+    // Up to kLinearSectors boundaries, their cross products' two terms are separable too: the
+    // same products beamIn() forms, computed once per row and column.
+    const int nb = box.shi - box.slo;
+    std::array<std::array<double, 4>, kLinearSectors> bxdy, bydx;
+    if (nb <= kLinearSectors) {
+      for (int b = 0; b < nb; ++b) {
+        const auto ku = static_cast<std::size_t>(box.slo + 1 + b), bu = static_cast<std::size_t>(b);
+        for (std::size_t t = 0; t < 4; ++t) {
+          bxdy[bu][t] = bnd_x[ku] * dy[t];
+          bydx[bu][t] = bnd_y[ku] * dx[t];
+        }
+      }
+    }
     for (unsigned i = 0; i < 16; ++i) {
       if ((hit >> i) & 1u) continue;
       const unsigned c = i & 3, r = i >> 2;
@@ -250,7 +263,14 @@ struct PreparedScan {
         continue;
       }
       if (d2 >= te_max && d2 > tu_max) continue;  // U
-      const long j = beamIn(dx[c], dy[r], box);
+      long j;
+      if (nb <= kLinearSectors) {  // beamIn()'s linear test, on the stored products
+        j = linearSector(box.slo, nb, kRayMargin * (std::fabs(dx[c]) + std::fabs(dy[r])),
+                         [&](std::size_t b) { return bxdy[b][r] - bydx[b][c]; });
+        if (j == kUnsure) j = beamOf(dx[c], dy[r]);
+      } else {
+        j = beamIn(dx[c], dy[r], box);
+      }
       if (j < 0 || j >= n) continue;  // outside the fan: U
       const CellClass cls = cellAt(static_cast<std::size_t>(j), d2);
       m.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << i;
@@ -313,6 +333,29 @@ struct PreparedScan {
     return lo;
   }
 
+  /// Returned by linearSector() when a boundary is too close to tell.
+  static constexpr long kUnsure = std::numeric_limits<long>::min();
+  /// The sector, among slo..slo + nb, of a direction whose cross product with boundary
+  /// slo + 1 + b is cross(b): slo plus the boundaries it is surely past (by more than tol), if it
+  /// is surely on one side of each and past none after one it is before; else kUnsure.
+  template <typename Cross>
+  static long linearSector(int slo, int nb, double tol, Cross cross) {
+    long j = slo;
+    bool ok = true, before = false;
+    for (int b = 0; b < nb; ++b) {
+      const double x = cross(static_cast<std::size_t>(b));
+      if (x > tol) {
+        ok = ok && !before;
+        ++j;
+      } else if (x < -tol) {
+        before = true;
+      } else {
+        ok = false;
+      }
+    }
+    return ok ? j : kUnsure;
+  }
+
   /// beamOf() for a cell of a narrow square: the last boundary it is surely past, unless it is
   /// too close to the next one to tell (then the reference's rounding decides, via beamOf). Up to
   /// kLinearSectors boundaries each one is tested (past the first j - slo of them, before the
@@ -320,21 +363,11 @@ struct PreparedScan {
   long beamIn(double dx, double dy, const BoxInfo& box) const {
     const double tol = kRayMargin * (std::fabs(dx) + std::fabs(dy));
     if (box.shi - box.slo <= kLinearSectors) {
-      long j = box.slo;
-      bool ok = true, before = false;
-      for (int k = box.slo + 1; k <= box.shi; ++k) {
-        const auto ku = static_cast<std::size_t>(k);
-        const double cross = bnd_x[ku] * dy - bnd_y[ku] * dx;
-        if (cross > tol) {
-          ok = ok && !before;
-          ++j;
-        } else if (cross < -tol) {
-          before = true;
-        } else {
-          ok = false;
-        }
-      }
-      return ok ? j : beamOf(dx, dy);
+      const long j = linearSector(box.slo, box.shi - box.slo, tol, [&](std::size_t b) {
+        const std::size_t ku = static_cast<std::size_t>(box.slo) + 1 + b;
+        return bnd_x[ku] * dy - bnd_y[ku] * dx;
+      });
+      return j != kUnsure ? j : beamOf(dx, dy);
     }
     const int j = lastSurelyPast(dx, dy, tol, box.slo, box.shi);
     if (j < box.shi) {
