@@ -138,7 +138,8 @@ void WaveletMap::save(const std::string& path) const {
     w.put(static_cast<std::int32_t>(detail::blockKeyX(kv.first)));
     w.put(static_cast<std::int32_t>(detail::blockKeyY(kv.first)));
     w.put(b.s);
-    w.put(static_cast<std::uint8_t>((b.known_all ? 1 : 0) | (b.known_any ? 2 : 0) | (b.has_root ? 4 : 0)));
+    w.put(static_cast<std::uint8_t>((b.known_all ? 1 : 0) | (b.known_any ? 2 : 0) |
+                                    (b.has_root ? 4 : 0)));
     if (b.has_root) writeNode(impl, b.root, impl.levels, &w);
   }
   auto& buf = w.buffer();
@@ -185,7 +186,9 @@ void WaveletMap::load(const std::string& path) {
   const std::size_t body = data.size() - 4;
   std::uint32_t stored_crc;
   std::memcpy(&stored_crc, data.data() + body, 4);
-  if (crc32(data.data(), body) != stored_crc) throw fail("checksum mismatch (truncated or corrupted)");
+  if (crc32(data.data(), body) != stored_crc) {
+    throw fail("checksum mismatch (truncated or corrupted)");
+  }
 
   Impl fresh(impl_->params);
   try {

@@ -14,9 +14,12 @@ struct PolicyName {
   const char* name;
 };
 constexpr PolicyName kPolicyNames[] = {
-    {PolicyType::kNone, "none"},           {PolicyType::kMax, "max"},
-    {PolicyType::kClamp, "clamp"},         {PolicyType::kForget, "forget"},
-    {PolicyType::kClampLower, "clamp_lower"}, {PolicyType::kClampUpper, "clamp_upper"},
+    {PolicyType::kNone, "none"},
+    {PolicyType::kMax, "max"},
+    {PolicyType::kClamp, "clamp"},
+    {PolicyType::kForget, "forget"},
+    {PolicyType::kClampLower, "clamp_lower"},
+    {PolicyType::kClampUpper, "clamp_upper"},
 };
 
 // Appends "<name> (<value>) must be <rule>" when `ok` is false.
@@ -28,18 +31,27 @@ void check(bool ok, const char* name, double value, const char* rule,
   out->push_back(s.str());
 }
 
-bool usesLowerClamp(PolicyType t) { return t == PolicyType::kClamp || t == PolicyType::kClampLower; }
-bool usesUpperClamp(PolicyType t) { return t == PolicyType::kClamp || t == PolicyType::kClampUpper; }
+bool usesLowerClamp(PolicyType t) {
+  return t == PolicyType::kClamp || t == PolicyType::kClampLower;
+}
+bool usesUpperClamp(PolicyType t) {
+  return t == PolicyType::kClamp || t == PolicyType::kClampUpper;
+}
 
 }  // namespace
 
 const char* toString(ScanStatus status) {
   switch (status) {
-    case ScanStatus::kOk: return "ok";
-    case ScanStatus::kEmpty: return "empty_scan";
-    case ScanStatus::kBadGeometry: return "bad_geometry";
-    case ScanStatus::kBadPose: return "bad_pose";
-    case ScanStatus::kNoValidBeam: return "no_valid_beam";
+    case ScanStatus::kOk:
+      return "ok";
+    case ScanStatus::kEmpty:
+      return "empty_scan";
+    case ScanStatus::kBadGeometry:
+      return "bad_geometry";
+    case ScanStatus::kBadPose:
+      return "bad_pose";
+    case ScanStatus::kNoValidBeam:
+      return "no_valid_beam";
   }
   return "unknown";
 }
@@ -102,13 +114,12 @@ std::vector<std::string> MapParams::validate() const {
         "> 0 log-odds", &v);
   check(finite(prune_threshold) && prune_threshold >= 0.0 && prune_threshold <= 1.0,
         "prune_threshold", prune_threshold, "in [0, 1] log-odds", &v);
-  check(finite(skip_tolerance) && skip_tolerance >= 0.0 && skip_tolerance <= 1.0,
-        "skip_tolerance", skip_tolerance, "in [0, 1] log-odds", &v);
+  check(finite(skip_tolerance) && skip_tolerance >= 0.0 && skip_tolerance <= 1.0, "skip_tolerance",
+        skip_tolerance, "in [0, 1] log-odds", &v);
   // The empty update must be able to move a cell: with a lower clamp, odd_emp cannot be smaller
   // than the whole clamp interval without making the upper bound unreachable in one step.
   if (usesLowerClamp(policy.type) && usesUpperClamp(policy.type)) {
-    check(policy.clamp_min < policy.clamp_max, "clamp_min", policy.clamp_min,
-          "< clamp_max", &v);
+    check(policy.clamp_min < policy.clamp_max, "clamp_min", policy.clamp_min, "< clamp_max", &v);
   }
   return v;
 }

@@ -47,8 +47,8 @@ class RasterWriter {
     for (int q = 0; q < 4; ++q) {
       const bool has = l > 1 && impl_.hasChild(*n, q);
       slot(has ? &impl_.child(*n, q) : nullptr, l - 1, ix0 + ((q & 1) ? half : 0),
-           iy0 + ((q & 2) ? half : 0), c[static_cast<std::size_t>(q)], m,
-           (n->known_all >> q) & 1u, (n->known_any >> q) & 1u);
+           iy0 + ((q & 2) ? half : 0), c[static_cast<std::size_t>(q)], m, (n->known_all >> q) & 1u,
+           (n->known_any >> q) & 1u);
     }
   }
 
@@ -62,7 +62,8 @@ class RasterWriter {
     for (int q = 0; q < 4; ++q) {
       const auto cq = static_cast<float>(c[static_cast<std::size_t>(q)]);
       if (l > 1 && impl_.hasChild(n, q)) {
-        best = std::max(best, maxObserved(impl_.child(n, q), l - 1, c[static_cast<std::size_t>(q)], m));
+        best = std::max(best,
+                        maxObserved(impl_.child(n, q), l - 1, c[static_cast<std::size_t>(q)], m));
       } else if ((n.known_any >> q) & 1u) {
         best = std::max(best, cq);
       }
@@ -146,7 +147,8 @@ Raster WaveletMap::exportScale(int scale, const CellBox& window, Aggregation agg
     r.box = CellBox{};
     return r;
   }
-  const auto count = static_cast<std::size_t>(window.width()) * static_cast<std::size_t>(window.height());
+  const auto count =
+      static_cast<std::size_t>(window.width()) * static_cast<std::size_t>(window.height());
   r.log_odds.assign(count, static_cast<float>(impl.init));
   r.known.assign(count, 0);
   RasterWriter writer(impl, &r, aggregation);
@@ -158,7 +160,8 @@ Raster WaveletMap::exportScale(int scale, const CellBox& window, Aggregation agg
                 detail::scaleUp(by, impl.levels), b.s, 1.0, b.known_all, b.known_any);
   };
   // Look the window's blocks up, or walk the hash when the window is larger than the map.
-  const double window_blocks = static_cast<double>(bx1 - bx0 + 1) * static_cast<double>(by1 - by0 + 1);
+  const double window_blocks =
+      static_cast<double>(bx1 - bx0 + 1) * static_cast<double>(by1 - by0 + 1);
   if (window_blocks <= static_cast<double>(impl.blocks.size())) {
     for (std::int64_t by = by0; by <= by1; ++by) {
       for (std::int64_t bx = bx0; bx <= bx1; ++bx) {
