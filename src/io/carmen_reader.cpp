@@ -189,14 +189,7 @@ std::string searchUpwards(const std::filesystem::path& start) {
 }  // namespace
 
 ScanView CarmenScan::view(double range_min) const {
-  ScanView v;
-  v.ranges = ranges.data();
-  v.count = ranges.size();
-  v.angle_min = angle_min;
-  v.angle_increment = angle_increment;
-  v.range_min = range_min;
-  v.range_max = range_max;
-  return v;
+  return ScanView{ranges.data(), ranges.size(), angle_min, angle_increment, range_min, range_max};
 }
 
 CarmenParseError::CarmenParseError(const std::string& file, std::size_t line,

@@ -60,14 +60,8 @@ struct Scan {
   double range_min = 0.0;
   double range_max = 0.0;
   wavog::ScanView view() const {
-    wavog::ScanView v;
-    v.ranges = ranges.data();
-    v.count = ranges.size();
-    v.angle_min = angle_min;
-    v.angle_increment = angle_increment;
-    v.range_min = range_min;
-    v.range_max = range_max;
-    return v;
+    return wavog::ScanView{ranges.data(),   ranges.size(), angle_min,
+                           angle_increment, range_min,     range_max};
   }
 };
 

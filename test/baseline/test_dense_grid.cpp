@@ -31,14 +31,7 @@ struct TestScan {
   double range_max = 30.0;
   double range_min = 0.05;
   ScanView view() const {
-    ScanView v;
-    v.ranges = ranges.data();
-    v.count = ranges.size();
-    v.angle_min = angle_min;
-    v.angle_increment = angle_increment;
-    v.range_min = range_min;
-    v.range_max = range_max;
-    return v;
+    return ScanView{ranges.data(), ranges.size(), angle_min, angle_increment, range_min, range_max};
   }
 };
 

@@ -36,14 +36,8 @@ std::vector<NamedParams> everyPolicy(double resolution, int block_levels) {
 }
 
 wavog::ScanView OwnedScan::view() const {
-  wavog::ScanView v;
-  v.ranges = ranges.data();
-  v.count = ranges.size();
-  v.angle_min = angle_min;
-  v.angle_increment = angle_increment;
-  v.range_min = range_min;
-  v.range_max = range_max;
-  return v;
+  return wavog::ScanView{ranges.data(),   ranges.size(), angle_min,
+                         angle_increment, range_min,     range_max};
 }
 
 OwnedScan RandomScans::next() {
@@ -64,13 +58,20 @@ OwnedScan RandomScans::next() {
   for (auto& z : s.ranges) {
     r = std::clamp(r + (u01(rng_) - 0.5) * 0.1 * s.range_max, 0.1, 0.95 * s.range_max);
     const double pick = u01(rng_);
-    if (pick < 0.04) z = std::numeric_limits<float>::quiet_NaN();
-    else if (pick < 0.08) z = inf;
-    else if (pick < 0.10) z = -inf;
-    else if (pick < 0.12) z = 0.0f;
-    else if (pick < 0.14) z = static_cast<float>(0.5 * s.range_min);
-    else if (pick < 0.17) z = static_cast<float>(s.range_max * (1.0 + u01(rng_)));
-    else z = static_cast<float>(r);
+    if (pick < 0.04)
+      z = std::numeric_limits<float>::quiet_NaN();
+    else if (pick < 0.08)
+      z = inf;
+    else if (pick < 0.10)
+      z = -inf;
+    else if (pick < 0.12)
+      z = 0.0f;
+    else if (pick < 0.14)
+      z = static_cast<float>(0.5 * s.range_min);
+    else if (pick < 0.17)
+      z = static_cast<float>(s.range_max * (1.0 + u01(rng_)));
+    else
+      z = static_cast<float>(r);
   }
   return s;
 }
