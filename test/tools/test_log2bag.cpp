@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "program_runner.h"
 #include "tool_support.h"
 #include "wavog_mapping/io/carmen_reader.h"
 
@@ -25,35 +26,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int status = -1;
-  std::string err;
-};
+using wavog_tool_test::dataFile;
+using wavog_tool_test::RunResult;
 
 fs::path workDir() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("wavog_log2bag_test_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = wavog_tool_test::freshDir("wavog_log2bag_test");
   return dir;
 }
 
 RunResult runLog2Bag(const std::string& args) {
-  const fs::path err = workDir() / "stderr.txt";
-  const std::string cmd = std::string(WAVOG_LOG2BAG) + " " + args + " 2> " + err.string();
-  RunResult r;
-  const int raw = std::system(cmd.c_str());
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  std::ifstream in(err);
-  r.err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  return r;
-}
-
-std::string dataFile(const std::string& name) {
-  const std::string dir = wavog::findDataDir(WAVOG_SOURCE_DIR);
-  return dir.empty() ? "" : (fs::path(dir) / name).string();
+  return wavog_tool_test::runProgram(WAVOG_LOG2BAG, args, workDir());
 }
 
 /// Every message of a bag, by topic, with the connection headers.

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "program_runner.h"
 #include "wavog_mapping/core/motion_compensation.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
@@ -31,39 +32,17 @@ namespace fs = std::filesystem;
 
 constexpr std::size_t kScans = 300;
 
-struct RunResult {
-  int status = -1;
-  std::string err;
-};
+using wavog_tool_test::dataFile;
+using wavog_tool_test::readText;
+using wavog_tool_test::RunResult;
 
 fs::path workDir() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("wavog_offline_test_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = wavog_tool_test::freshDir("wavog_offline_test");
   return dir;
 }
 
-std::string readText(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 RunResult run(const std::string& program, const std::string& args) {
-  const fs::path err = workDir() / "stderr.txt";
-  const std::string cmd = program + " " + args + " 2> " + err.string();
-  RunResult r;
-  const int raw = std::system(cmd.c_str());
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.err = readText(err);
-  return r;
-}
-
-std::string dataFile(const std::string& name) {
-  const std::string dir = wavog::findDataDir(WAVOG_SOURCE_DIR);
-  return dir.empty() ? "" : (fs::path(dir) / name).string();
+  return wavog_tool_test::runProgram(program, args, workDir());
 }
 
 /// Compiled defaults, through the same loader as the tool.
