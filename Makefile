@@ -20,10 +20,7 @@ $(BUILD)/CMakeCache.txt: | deps
 	  || { cat $(BUILD)/configure.log; exit 1; }
 
 build: deps $(BUILD)/CMakeCache.txt
-	@cmake --build $(BUILD) -j$(JOBS) -- --no-print-directory
-	@# catkin's gtest / rostest executables hang off its `tests` target, outside `all`.
-	@if cmake --build $(BUILD) --target help | grep '\.\.\. tests$$' >/dev/null; then \
-	  cmake --build $(BUILD) --target tests -j$(JOBS) -- --no-print-directory; fi
+	@bash $(ROOT)/scripts/build.sh $(BUILD) $(JOBS)
 
 ## Every test (core gtests and rostests); ends with "N passed, N failed".
 test: build
@@ -35,7 +32,7 @@ test-asan: deps
 	@cmake -S $(ROOT) -B $(BUILD_ASAN) -DCATKIN_DEVEL_PREFIX=$(BUILD_ASAN)/devel $(CMAKE_ARGS) \
 	  -DWAVOG_SANITIZE="address;undefined;float-cast-overflow" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWAVOG_BUILD_ROS=OFF \
 	  >$(BUILD_ASAN)/configure.log || { cat $(BUILD_ASAN)/configure.log; exit 1; }
-	@cmake --build $(BUILD_ASAN) --target core_tests -j$(JOBS) -- --no-print-directory
+	@bash $(ROOT)/scripts/build.sh $(BUILD_ASAN) $(JOBS) core_tests
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  bash $(ROOT)/scripts/run_tests.sh $(BUILD_ASAN) -L core
 

@@ -15,8 +15,8 @@ tsan: deps
 	@cmake -S $(ROOT) -B $(BUILD_TSAN) -DCATKIN_DEVEL_PREFIX=$(BUILD_TSAN)/devel $(CMAKE_ARGS) \
 	  -DWAVOG_SANITIZE=thread -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  >$(BUILD_TSAN)/configure.log || { cat $(BUILD_TSAN)/configure.log; exit 1; }
-	@cmake --build $(BUILD_TSAN) -j$(JOBS) --target wavog_mapping_node test_mapping_system \
-	  test_bad_input -- --no-print-directory
+	@bash $(ROOT)/scripts/build.sh $(BUILD_TSAN) $(JOBS) wavog_mapping_node test_mapping_system \
+	  test_bad_input
 	@rm -f $(BUILD_TSAN)/tsan/report.*
 	@$(ROS_ENV); source $(BUILD_TSAN)/devel/setup.bash; \
 	  export ROS_HOME=$(BUILD_TSAN)/ros_home; \
