@@ -810,7 +810,7 @@ class Integrator {
   double visitNode(Node& n, const BoxInfo& box, int l, std::int64_t ix0, std::int64_t iy0,
                    double s) {
     ++visited_;
-    if (n.k != 0) impl_.flush(n);
+    impl_.flush(n);
     // The children are read after the (long) classification: fetch them meanwhile.
     if (n.children != 0) impl_.pool.prefetch(n.children);
     if (l == 1) return visitLeafParent(n, box, ix0, iy0, s);
@@ -891,7 +891,7 @@ class Integrator {
           [&]() { impl_.removeChild(n, q); },
           [&](Node& m) {
             ++visited_;
-            if (m.k != 0) impl_.flush(m);
+            impl_.flush(m);
             return updateCells(m, cc, c[qu]);
           });
       detail::setBit(&n.known_all, bit, all);
