@@ -8,6 +8,11 @@ JOBS ?= $(shell nproc)
 export PATH := /usr/bin:$(PATH)
 CMAKE_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
   -DCATKIN_ENABLE_TESTING=ON
+# ccache, where the machine has it, shortens rebuilds (not installed by deps; optional).
+ifneq ($(shell command -v ccache 2>/dev/null),)
+CMAKE_ARGS += -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache
+export CCACHE_BASEDIR ?= $(abspath $(ROOT)/..)
+endif
 
 .PHONY: deps build test test-asan bench clean
 
