@@ -23,6 +23,11 @@ PANEL = "abcdefgh"
 UNKNOWN_RGBA = (0.80, 0.88, 0.97, 1.0)
 
 
+def num(v, digits=1):
+    """v rounded for a label, without a minus sign on zero (-1e-7 after the Haar round trip)."""
+    return f"{round(v, digits) + 0.0:.{digits}f}"
+
+
 def load_raster(directory, side):
     w, h = side["width"], side["height"]
     lo = np.fromfile(os.path.join(directory, side["log_odds_file"]), dtype="<f4").reshape(h, w)
@@ -69,7 +74,8 @@ def draw_map(fig, ax, lo, known, ext, title, vmin=None, vmax=None, mark_unknown=
 
 def unknown_legend(fig):
     patch = matplotlib.patches.Patch(color=UNKNOWN_RGBA, label="never observed (the prior)")
-    fig.legend(handles=[patch], loc="lower right", fontsize=9, frameon=True)
+    fig.legend(handles=[patch], loc="upper center", bbox_to_anchor=(0.5, 0.0), fontsize=10,
+               frameon=True)
 
 
 def zoom_box(ax, window):
@@ -102,15 +108,15 @@ def main():
         lo, known = load_raster(d, side)
         ax = axes[i // cols][i % cols]
         draw_map(fig, ax, lo, known, extent(side),
-                 f"({PANEL[i]}) {label}: log-odds {side['min_log_odds']:.1f} .. "
-                 f"{side['max_log_odds']:.1f}")
+                 f"({PANEL[i]}) {label}: log-odds {num(side['min_log_odds'])} .. "
+                 f"{num(side['max_log_odds'])}")
         zoom_box(ax, zoom)
     fig.suptitle(f"Fig. 1.2: log-odds maps of {log} ({stats['scans']} scans, "
                  f"{side0['cell_size_m'] * 100:.0f} cm cells)\nbrighter = more occupied; each "
                  "scale from its map's min to max log-odds; red box: the zoom of Fig. 1.3",
                  fontsize=12)
     unknown_legend(fig)
-    fig.savefig(os.path.join(d, "fig_1_2.png"), dpi=110)
+    fig.savefig(os.path.join(d, "fig_1_2.png"), dpi=110, bbox_inches="tight")
     plt.close(fig)
 
     # Fig. 1.3: the same zoom for the four.
@@ -127,7 +133,7 @@ def main():
     fig.suptitle(f"Fig. 1.3: zoom x {zoom[0]:g}..{zoom[2]:g} m, y {zoom[1]:g}..{zoom[3]:g} m; "
                  "each scale from the zoom's min to max log-odds", fontsize=11)
     unknown_legend(fig)
-    fig.savefig(os.path.join(d, "fig_1_3.png"), dpi=110)
+    fig.savefig(os.path.join(d, "fig_1_3.png"), dpi=110, bbox_inches="tight")
     plt.close(fig)
 
     # Fig. 1.4: forgetting with the empty-bound prior, whole map and zoom.
@@ -149,7 +155,7 @@ def main():
                  f"{r['nodes']} nodes (unknown prior: "
                  f"{runs['forget']['bytes_per_observed_cell']:.2f}, {runs['forget']['nodes']})",
                  fontsize=12)
-    fig.savefig(os.path.join(d, "fig_1_4.png"), dpi=110)
+    fig.savefig(os.path.join(d, "fig_1_4.png"), dpi=110, bbox_inches="tight")
     plt.close(fig)
 
     # Fig. 1.6: scales 0, 2, 3, 4 of the forgetting map.
@@ -168,11 +174,11 @@ def main():
                  f"({PANEL[i]}) scale {side['scale']}, cells {cm:.0f} cm x {cm:.0f} cm\n"
                  f"{side['known_cells']:,} observed of {side['cells']:,} cells{vs0}")
     fig.suptitle("Fig. 1.6: scales 0, 2, 3, 4 of the forgetting map of "
-                 f"{log}\n(Haar averages: mean log-odds of the finest cells; a coarse cell is "
-                 "observed if any finest cell under it is; 4^s finest cells per scale-s cell)",
+                 f"{log}\n(Haar averages: mean log-odds of the 4^s finest cells under a cell, unobserved "
+                 "ones at the prior 0, hence the paler rim; observed if any of them is)",
                  fontsize=12)
     unknown_legend(fig)
-    fig.savefig(os.path.join(d, "fig_1_6.png"), dpi=110)
+    fig.savefig(os.path.join(d, "fig_1_6.png"), dpi=110, bbox_inches="tight")
     plt.close(fig)
     print(f"paper_figures: wrote {d}/fig_1_2.png, fig_1_3.png, fig_1_4.png, fig_1_6.png")
 

@@ -64,6 +64,7 @@ WallFigures wallFigures(const World& world, const PolicyResult& result, double t
                         const WallProfileOptions& options) {
   WallFigures f;
   f.wall_distance_m = result.wall_distance;
+  f.surface_distance_m = meanDistanceToWallSurface(world, t, result.final_map);
   f.width = wallWidthAtHalfMax(result.final_map, wallSamplesFromWorld(world, t, options), options);
   return f;
 }
@@ -72,19 +73,25 @@ std::vector<NoiseStudyRow> runNoiseStudy(const World& world, const std::vector<S
                                          const std::vector<WorldEvent>& events,
                                          const std::vector<PolicyRun>& runs,
                                          const std::vector<NoiseLevel>& levels,
-                                         const EvaluationOptions& options, int jobs) {
+                                         const EvaluationOptions& options, int jobs,
+                                         const std::vector<PolicyResult>* exact) {
+  if (exact && exact->size() != runs.size()) {
+    throw std::invalid_argument("runNoiseStudy: one exact-pose result per run expected");
+  }
   std::vector<NoiseStudyRow> rows(levels.size() * runs.size());
   const double t_end = scans.empty() ? 0.0 : scans.back().stamp;
   for (std::size_t l = 0; l < levels.size(); ++l) {
+    const bool reuse = exact && !levels[l].noise.enabled();
     // One copy of the scans per level, shared read-only by the level's runs.
-    const std::vector<SimScan> noisy = withPoseError(world, scans, levels[l].noise);
+    const std::vector<SimScan> noisy =
+        reuse ? std::vector<SimScan>() : withPoseError(world, scans, levels[l].noise);
     std::atomic<std::size_t> next{0};
     auto worker = [&]() {
       for (std::size_t r = next++; r < runs.size(); r = next++) {
         NoiseStudyRow& row = rows[l * runs.size() + r];
         row.level = levels[l].label;
         row.noise = levels[l].noise;
-        row.result = evaluatePolicy(world, noisy, events, runs[r], options);
+        row.result = reuse ? (*exact)[r] : evaluatePolicy(world, noisy, events, runs[r], options);
         row.walls = wallFigures(world, row.result, t_end);
         row.result.final_map = Raster();
       }
@@ -106,12 +113,14 @@ std::string noiseStudyMarkdown(const std::vector<NoiseStudyRow>& rows) {
      << "(sigma on x and y, and on the heading; the lasers still measure from the true pose). "
      << "The first level is the table above, unchanged.\n\n"
      << "| pose noise (sigma xy / yaw) | policy / init | occupied precision | recall | "
-        "wall distance (cm) | wall width at half max (cells, mean / median) | profiles | "
-        "nodes | bytes / observed cell |\n|---|---|---|---|---|---|---|---|---|\n";
+        "wall distance (cm) | distance to wall surface (cm) | wall width at half max (cells, "
+        "mean / median) | profiles | nodes | bytes / observed cell |\n"
+        "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const NoiseStudyRow& row : rows) {
     const PolicyResult& r = row.result;
     md << "| " << row.level << " | " << r.label << " | " << fixed(r.precision, 3) << " | "
        << fixed(r.recall, 3) << " | " << fixed(100 * row.walls.wall_distance_m, 1) << " | "
+       << fixed(100 * row.walls.surface_distance_m, 1) << " | "
        << fixed(row.walls.width.mean_cells, 2) << " / " << fixed(row.walls.width.median_cells, 1)
        << " | " << row.walls.width.measured << " of " << row.walls.width.samples << " | "
        << r.nodes << " | " << fixed(r.bytes_per_observed_cell, 2) << " |\n";
@@ -124,7 +133,12 @@ std::string noiseStudyMarkdown(const std::vector<NoiseStudyRow>& rows) {
      << "cells. *profiles*: measured of asked for (a face never seen occupied is not measured). "
      << "One cell is ideal.\n"
      << "- *wall distance*: as above (mean distance of occupied cells nearest to a wall, within "
-     << "1 m, to the wall).\n";
+     << "1 m, to the wall's cells; 0 for a cell inside the wall, so hits pushed into a wall "
+     << "lower it). *distance to wall surface*: the same cells, distance to the nearest cell the "
+     << "wall's surface passes through (cells inside count too; 0 is ideal).\n"
+     << "- The pose error is drawn per scan (x, y and heading, independent Gaussians) and added "
+     << "to the true vehicle pose before the laser's mount; the ranges are those measured from "
+     << "the true pose (`include/wavog_mapping/sim/pose_noise.h`).\n";
   return md.str();
 }
 
@@ -141,6 +155,7 @@ std::string noiseStudyJson(const std::vector<NoiseStudyRow>& rows) {
                    {"precision", r.precision},
                    {"recall", r.recall},
                    {"wall_distance_m", row.walls.wall_distance_m},
+                   {"wall_surface_distance_m", row.walls.surface_distance_m},
                    {"wall_width_mean_cells", row.walls.width.mean_cells},
                    {"wall_width_median_cells", row.walls.width.median_cells},
                    {"wall_profiles_measured", row.walls.width.measured},

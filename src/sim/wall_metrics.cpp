@@ -6,6 +6,8 @@
 #include <set>
 #include <utility>
 
+#include "wavog_mapping/sim/ground_truth.h"
+
 namespace wavog {
 namespace sim {
 namespace {
@@ -174,6 +176,34 @@ WallWidth wallWidthAtHalfMax(const Raster& map, const std::vector<WallSample>& s
   const std::size_t m = widths.size() / 2;
   result.median_cells = widths.size() % 2 ? widths[m] : 0.5 * (widths[m - 1] + widths[m]);
   return result;
+}
+
+double meanDistanceToWallSurface(const World& world, double t, const Raster& map, double margin_m,
+                                 std::size_t* cells) {
+  GridWindow window;
+  window.resolution = map.cell_size;
+  window.min_x = map.box.min_x;
+  window.min_y = map.box.min_y;
+  window.width = static_cast<int>(map.box.width());
+  window.height = static_cast<int>(map.box.height());
+  const std::vector<float> to_surface =
+      distanceTransform(surfaceAt(world, t, window, TruthFilter::kWallsOnly), window);
+  const std::vector<std::uint8_t> walls = occupancyAt(world, t, window, TruthFilter::kWallsOnly);
+  const std::vector<float> to_wall = distanceTransform(walls, window);
+  std::vector<std::uint8_t> others = occupancyAt(world, t, window, TruthFilter::kAll);
+  for (std::size_t i = 0; i < others.size(); ++i) others[i] = others[i] && !walls[i];
+  const std::vector<float> to_other = distanceTransform(others, window);
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < window.size(); ++i) {
+    if (!map.known[i] || !(map.log_odds[i] > 1e-3f)) continue;
+    if (to_wall[i] <= margin_m && to_wall[i] < to_other[i]) {
+      sum += to_surface[i];
+      ++n;
+    }
+  }
+  if (cells) *cells = n;
+  return n ? sum / static_cast<double>(n) : 0.0;
 }
 
 }  // namespace sim

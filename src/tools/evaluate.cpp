@@ -425,29 +425,33 @@ void printHeadline(const std::vector<WorldEvent>& events,
 // The pose-error study (noise_study.h) over the paper's four policies, appended to report.md.
 void runPoseNoiseStudy(const World& world, const std::vector<SimScan>& scans,
                        const std::vector<WorldEvent>& events, const std::vector<PolicyRun>& runs,
-                       const EvaluationOptions& eo, const Options& o) {
+                       const std::vector<PolicyResult>& results, const EvaluationOptions& eo,
+                       const Options& o) {
   const std::vector<NoiseLevel> levels = parseNoiseLevels(o.pose_noise, o.seed);
   std::vector<PolicyRun> paper_runs;
-  for (const PolicyRun& r : runs) {
-    if (r.params.policy.init == wavog::InitValue::kUnknown &&
-        r.params.policy.type != wavog::PolicyType::kClampLower) {
-      paper_runs.push_back(r);
+  std::vector<PolicyResult> exact;  // today's results of those runs, reused for level 0
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (runs[i].params.policy.init == wavog::InitValue::kUnknown &&
+        runs[i].params.policy.type != wavog::PolicyType::kClampLower) {
+      paper_runs.push_back(runs[i]);
+      exact.push_back(results[i]);
     }
   }
   if (paper_runs.empty()) return;
   std::cerr << "wavog_evaluate: pose-noise study, " << levels.size() << " levels x "
             << paper_runs.size() << " policies...\n";
   const std::vector<NoiseStudyRow> rows =
-      runNoiseStudy(world, scans, events, paper_runs, levels, eo, o.jobs);
+      runNoiseStudy(world, scans, events, paper_runs, levels, eo, o.jobs, &exact);
   std::ofstream(o.out_dir + "/report.md", std::ios::app) << "\n" << noiseStudyMarkdown(rows);
   std::ofstream(o.out_dir + "/noise.json") << noiseStudyJson(rows);
   std::cout << "\n" << std::left << std::setw(22) << "pose noise" << std::setw(26) << "policy"
-            << std::setw(11) << "precision" << std::setw(10) << "wall cm"
-            << "wall width (cells)\n";
+            << std::setw(11) << "precision" << std::setw(10) << "wall cm" << std::setw(13)
+            << "surface cm" << "wall width (cells)\n";
   for (const NoiseStudyRow& row : rows) {
     std::cout << std::setw(22) << row.level << std::setw(26) << row.result.label << std::setw(11)
               << fixed(row.result.precision, 3) << std::setw(10)
-              << fixed(100 * row.walls.wall_distance_m, 1) << fixed(row.walls.width.mean_cells, 2)
+              << fixed(100 * row.walls.wall_distance_m, 1) << std::setw(13)
+              << fixed(100 * row.walls.surface_distance_m, 1) << fixed(row.walls.width.mean_cells, 2)
               << "\n";
   }
   std::cout << std::right << std::flush;
@@ -519,7 +523,7 @@ int run(const Options& o) {
             << "departure.png, arrival.png, summary.json} in " << fixed(wall_s, 1) << " s\n";
   if (!o.core_maps.empty()) writeCoreMaps(world, scans, o.core_maps);
   printHeadline(events, results);
-  if (o.pose_noise != "none") runPoseNoiseStudy(world, scans, events, runs, eo, o);
+  if (o.pose_noise != "none") runPoseNoiseStudy(world, scans, events, runs, results, eo, o);
   return 0;
 }
 

@@ -39,6 +39,8 @@ struct Options {
   // Zoom window (m, map frame) of Fig. 1.3 / 1.4 (b): see the default in main().
   std::vector<double> zoom;
   double bound_tolerance = 0.01;
+  bool zoom_is_default = false;
+  int zoom_passes = 0;  // times the robot enters the zoom window (counted from the log)
 };
 
 /// One map of the paper's figures.
@@ -133,7 +135,7 @@ bool policyBounds(const wavog::MapParams& p, double* lo, double* hi) {
   }
 }
 
-int run(const Options& o) {
+int run(Options o) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
   makeDir(o.out_dir);
@@ -145,6 +147,15 @@ int run(const Options& o) {
   std::vector<const wavog::CarmenScan*> used;
   for (const wavog::CarmenScan& s : scans) {
     if (!(has_flaser && s.type == "ROBOTLASER1")) used.push_back(&s);
+  }
+  if (o.zoom_is_default) {
+    bool inside = false;
+    for (const wavog::CarmenScan* s : used) {
+      const bool now = s->robot_pose.x > o.zoom[0] && s->robot_pose.x < o.zoom[2] &&
+                       s->robot_pose.y > o.zoom[1] && s->robot_pose.y < o.zoom[3];
+      o.zoom_passes += now && !inside;
+      inside = now;
+    }
   }
   const std::vector<PaperRun> runs = paperRuns();
   std::vector<wavog::WaveletMap> maps;
@@ -307,7 +318,21 @@ int run(const Options& o) {
      << "- *wall width*: " << stats["wall_width_method"].get<std::string>() << "; " << walls.size()
      << " profiles. One cell is ideal.\n"
      << "- *bytes / observed cell*: `WaveletMap::stats().bytes` over the cells ever observed; a "
-     << "dense float grid costs 4.\n";
+     << "dense float grid costs 4.\n\n"
+     << "Zoom of Fig. 1.3 and 1.4 (b): x " << o.zoom[0] << " .. " << o.zoom[2] << " m, y "
+     << o.zoom[1] << " .. " << o.zoom[3] << " m (map frame)";
+  if (o.zoom_is_default) {
+    md << ": the middle of the main corridor, with both corridor walls and the doorways of "
+       << "the rooms beside it; the robot drives through this window " << o.zoom_passes
+       << " times and looks into it from the rooms, so its walls are seen "
+       << "from many vantage points";
+  }
+  md << ".\n\n"
+     << "![Fig. 1.2](fig_1_2.png)\n\n![Fig. 1.3](fig_1_3.png)\n\n![Fig. 1.4](fig_1_4.png)\n\n"
+     << "![Fig. 1.6](fig_1_6.png)\n\n"
+     << "Made by `make paper`, i.e. `wavog_paper --out DIR " << o.log << "` then "
+     << "`/usr/bin/python3 scripts/paper_figures.py DIR`. The rasters behind the figures are in "
+     << "DIR (`<map>_s<scale>.f32` float32 log-odds, `.known.u8`, `.json` sidecar).\n";
   std::ofstream(o.out_dir + "/report.md") << md.str();
   std::cerr << "wavog_paper: wrote " << o.out_dir << "/{stats.json, report.md, *.f32} in "
             << fixed(stats["wall_time_s"].get<double>(), 1) << " s\n";
@@ -341,7 +366,10 @@ int main(int argc, char** argv) {
       if (dir.empty()) throw std::runtime_error("no data directory found; set WAVOG_DATA_DIR");
       o.log = dir + "/fr079-corrected.log.gz";
     }
-    if (o.zoom.empty()) o.zoom = {-5.0, -3.0, 5.0, 3.0};
+    if (o.zoom.empty()) {
+      o.zoom = {-5.0, -3.0, 5.0, 3.0};
+      o.zoom_is_default = true;
+    }
     if (!(o.zoom[0] < o.zoom[2] && o.zoom[1] < o.zoom[3])) {
       throw std::invalid_argument("--zoom: X0 < X1 and Y0 < Y1 required");
     }

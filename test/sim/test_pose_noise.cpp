@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 
 #include "wavog_mapping/sim/evaluation.h"
 #include "wavog_mapping/sim/laser_sim.h"
@@ -209,6 +210,9 @@ TEST_F(ThickWalls, MaxAndClampThickenWallsAsPoseNoiseGrows) {
       EXPECT_GE(row.walls.width.measured, 60u) << row.level;
       EXPECT_GT(row.walls.width.mean_cells, previous)
           << runs[r].label << " at " << row.level << " is not thicker than at the level below";
+      std::cout << runs[r].label << " at " << row.level << ": wall width "
+                << row.walls.width.mean_cells << " cells, distance to the wall surface "
+                << 100 * row.walls.surface_distance_m << " cm\n";
       previous = row.walls.width.mean_cells;
     }
   }

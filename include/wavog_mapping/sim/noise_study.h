@@ -27,7 +27,8 @@ std::vector<NoiseLevel> parseNoiseLevels(const std::string& text, std::uint64_t 
 
 /// The wall figures of one final map against the world's walls at time t.
 struct WallFigures {
-  double wall_distance_m = 0.0;  ///< PolicyResult::wall_distance
+  double wall_distance_m = 0.0;     ///< PolicyResult::wall_distance (0 inside a wall)
+  double surface_distance_m = 0.0;  ///< meanDistanceToWallSurface (inside and outside alike)
   WallWidth width;               ///< across the walls' free faces (wallSamplesFromWorld)
 };
 WallFigures wallFigures(const World& world, const PolicyResult& result, double t,
@@ -42,12 +43,15 @@ struct NoiseStudyRow {
 };
 
 /// Every run at every level: the scans with withPoseError(level) through evaluatePolicy. Rows in
-/// level-major order. `events` come from the true scans.
+/// level-major order. `events` come from the true scans. `exact` (if given: one result per run,
+/// same order, from the true scans with the same options, final_map kept) is used as is for the
+/// levels without error instead of mapping them again.
 std::vector<NoiseStudyRow> runNoiseStudy(const World& world, const std::vector<SimScan>& scans,
                                          const std::vector<WorldEvent>& events,
                                          const std::vector<PolicyRun>& runs,
                                          const std::vector<NoiseLevel>& levels,
-                                         const EvaluationOptions& options, int jobs);
+                                         const EvaluationOptions& options, int jobs,
+                                         const std::vector<PolicyResult>* exact = nullptr);
 
 /// The study as a Markdown section (table and definitions) and as JSON.
 std::string noiseStudyMarkdown(const std::vector<NoiseStudyRow>& rows);

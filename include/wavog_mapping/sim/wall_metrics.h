@@ -64,6 +64,13 @@ struct WallWidth {
 WallWidth wallWidthAtHalfMax(const Raster& map, const std::vector<WallSample>& samples,
                              const WallProfileOptions& options);
 
+/// Mean distance (m) from the map's occupied cells (observed, log-odds > 1e-3) that lie within
+/// `margin_m` of a wall present at t, and nearer to a wall than to any other object, to the
+/// nearest cell a wall's surface passes through (0 on the surface, inside or outside alike; 0
+/// is ideal). `cells` (if given) receives the number of cells averaged. 0 when there are none.
+double meanDistanceToWallSurface(const World& world, double t, const Raster& map,
+                                 double margin_m = 1.0, std::size_t* cells = nullptr);
+
 }  // namespace sim
 }  // namespace wavog
 
