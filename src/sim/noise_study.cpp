@@ -51,9 +51,9 @@ std::vector<NoiseLevel> parseNoiseLevels(const std::string& text, std::uint64_t 
     l.noise.sigma_xy_m = cm / 100.0;
     l.noise.sigma_yaw_rad = deg * M_PI / 180.0;
     l.noise.seed = seed;
-    l.label = l.noise.enabled() ? fixed(cm, cm == std::round(cm) ? 0 : 1) + " cm / " +
-                                      fixed(deg, 2) + " deg"
-                                : "0 (exact poses)";
+    l.label = l.noise.enabled()
+                  ? fixed(cm, cm == std::round(cm) ? 0 : 1) + " cm / " + fixed(deg, 2) + " deg"
+                  : "0 (exact poses)";
     levels.push_back(l);
   }
   if (levels.empty()) throw std::invalid_argument("no pose-noise level given");
@@ -122,8 +122,8 @@ std::string noiseStudyMarkdown(const std::vector<NoiseStudyRow>& rows) {
        << fixed(r.recall, 3) << " | " << fixed(100 * row.walls.wall_distance_m, 1) << " | "
        << fixed(100 * row.walls.surface_distance_m, 1) << " | "
        << fixed(row.walls.width.mean_cells, 2) << " / " << fixed(row.walls.width.median_cells, 1)
-       << " | " << row.walls.width.measured << " of " << row.walls.width.samples << " | "
-       << r.nodes << " | " << fixed(r.bytes_per_observed_cell, 2) << " |\n";
+       << " | " << row.walls.width.measured << " of " << row.walls.width.samples << " | " << r.nodes
+       << " | " << fixed(r.bytes_per_observed_cell, 2) << " |\n";
   }
   md << "\n- *wall width at half max*: across the free faces of the true walls, every 0.5 m "
      << "(faces of at least 1.5 m, 0.5 m from their ends), the profile of P(occ) from 0.5 m "

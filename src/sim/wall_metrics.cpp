@@ -132,7 +132,8 @@ WallWidth wallWidthAtHalfMax(const Raster& map, const std::vector<WallSample>& s
     for (int k = lo; k <= hi; ++k) {
       const long long i = indexAt(map, s.point + (k * step) * s.normal);
       if (i >= 0 && map.known[static_cast<std::size_t>(i)]) {
-        profile[static_cast<std::size_t>(k - lo)] = probability(map.log_odds[static_cast<std::size_t>(i)]);
+        profile[static_cast<std::size_t>(k - lo)] =
+            probability(map.log_odds[static_cast<std::size_t>(i)]);
       }
     }
     // Peak near the surface, base on the free side (either side when two-sided).

@@ -66,7 +66,7 @@ void usage(std::ostream& out) {
          "  --core-maps DIR       also map the scenario with the default parameters (forgetting,\n"
          "                        5 cm) through the core and write map_s<scale>.png/.pgm/.yaml\n"
          "                        for scales 0, 2, 3, 4 there (when wavog_offline is missing)\n"
-         "  --pose-noise LEVELS   pose-error study of none, max, clamp and forget: comma-separated\n"
+         "  --pose-noise LEVELS   pose-error study of none, max, clamp, forget: a list of\n"
          "                        SIGMA_XY_CM:SIGMA_YAW_DEG levels (default 0:0,2:0.2,5:0.5;\n"
          "                        'none' skips it); appended to report.md, also noise.json\n";
 }
@@ -444,15 +444,17 @@ void runPoseNoiseStudy(const World& world, const std::vector<SimScan>& scans,
       runNoiseStudy(world, scans, events, paper_runs, levels, eo, o.jobs, &exact);
   std::ofstream(o.out_dir + "/report.md", std::ios::app) << "\n" << noiseStudyMarkdown(rows);
   std::ofstream(o.out_dir + "/noise.json") << noiseStudyJson(rows);
-  std::cout << "\n" << std::left << std::setw(22) << "pose noise" << std::setw(26) << "policy"
+  std::cout << "\n"
+            << std::left << std::setw(22) << "pose noise" << std::setw(26) << "policy"
             << std::setw(11) << "precision" << std::setw(10) << "wall cm" << std::setw(13)
-            << "surface cm" << "wall width (cells)\n";
+            << "surface cm"
+            << "wall width (cells)\n";
   for (const NoiseStudyRow& row : rows) {
     std::cout << std::setw(22) << row.level << std::setw(26) << row.result.label << std::setw(11)
               << fixed(row.result.precision, 3) << std::setw(10)
               << fixed(100 * row.walls.wall_distance_m, 1) << std::setw(13)
-              << fixed(100 * row.walls.surface_distance_m, 1) << fixed(row.walls.width.mean_cells, 2)
-              << "\n";
+              << fixed(100 * row.walls.surface_distance_m, 1)
+              << fixed(row.walls.width.mean_cells, 2) << "\n";
   }
   std::cout << std::right << std::flush;
 }

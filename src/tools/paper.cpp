@@ -53,8 +53,8 @@ struct PaperRun {
 std::vector<PaperRun> paperRuns() {
   using wavog::PolicyType;
   std::vector<PaperRun> runs;
-  for (PolicyType t : {PolicyType::kNone, PolicyType::kMax, PolicyType::kClamp,
-                       PolicyType::kForget}) {
+  for (PolicyType t :
+       {PolicyType::kNone, PolicyType::kMax, PolicyType::kClamp, PolicyType::kForget}) {
     runs.push_back({wavog::toString(t), wavog::toString(t), wavog::MapParams::defaultsFor(t)});
   }
   PaperRun empty{"forget_empty_bound", "forget, empty-bound prior",
@@ -311,8 +311,8 @@ int run(Options o) {
     md << fixed(jr["wall_width_mean_cells"].get<double>(), 2) << " / "
        << fixed(jr["wall_width_median_cells"].get<double>(), 1) << " |\n";
   }
-  md << "\n- *at lower / upper bound*: share of the observed cells within "
-     << o.bound_tolerance << " log-odds of the policy's bounds: clamp [clamp_min, clamp_max], "
+  md << "\n- *at lower / upper bound*: share of the observed cells within " << o.bound_tolerance
+     << " log-odds of the policy's bounds: clamp [clamp_min, clamp_max], "
      << "forget the fixed points [odd_emp, odd_occ], max [prior, odd_occ] (an empty reading "
      << "never lowers a cell below its prior); none has no bounds.\n"
      << "- *wall width*: " << stats["wall_width_method"].get<std::string>() << "; " << walls.size()
@@ -344,8 +344,9 @@ int run(Options o) {
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app{"wavog_paper: maps a CARMEN log with the paper's policies and exports the rasters "
-               "and figures of merit behind fig_1_2/1_3/1_4/1_6 (scripts/paper_figures.py)."};
+  CLI::App app{
+      "wavog_paper: maps a CARMEN log with the paper's policies and exports the rasters "
+      "and figures of merit behind fig_1_2/1_3/1_4/1_6 (scripts/paper_figures.py)."};
   app.add_option("log", o.log, "CARMEN log (default: fr079-corrected.log.gz in the data dir)");
   app.add_option("-o,--out", o.out_dir, "output folder")->capture_default_str();
   app.add_option("--max-scans", o.max_scans, "map only the first N scans (0: all)")

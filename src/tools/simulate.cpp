@@ -54,7 +54,8 @@ struct Options {
   double truth_resolution = 0.1;
   double truth_every = 10.0;
   std::string write_world;  // write the world as YAML here
-  wavog::sim::PoseNoiseParams pose_noise;  // error of the /tf poses (the lasers see the truth)
+  // Error of the /tf poses (the lasers measure from the true pose).
+  wavog::sim::PoseNoiseParams pose_noise;
 };
 
 void usage(std::ostream& out) {

@@ -143,7 +143,8 @@ TEST(WallMetrics, HalfMaxWidthOfSyntheticWalls) {
     r.log_odds.assign(2400, -2.0f);
     r.known.assign(2400, 1);
     for (int y = 0; y < 60; ++y) {
-      for (int x = 20; x < 20 + thickness; ++x) r.log_odds[static_cast<std::size_t>(y) * 40 + x] = 3.0f;
+      for (int x = 20; x < 20 + thickness; ++x)
+        r.log_odds[static_cast<std::size_t>(y) * 40 + x] = 3.0f;
       for (int x = 0; x < 20; ++x) r.known[static_cast<std::size_t>(y) * 40 + x] = 0;  // behind
     }
     // Free face at x = 2.0 + thickness * 0.1, normal +x; the wall's back (x < 2) unobserved.

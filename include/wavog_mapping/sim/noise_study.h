@@ -29,7 +29,7 @@ std::vector<NoiseLevel> parseNoiseLevels(const std::string& text, std::uint64_t 
 struct WallFigures {
   double wall_distance_m = 0.0;     ///< PolicyResult::wall_distance (0 inside a wall)
   double surface_distance_m = 0.0;  ///< meanDistanceToWallSurface (inside and outside alike)
-  WallWidth width;               ///< across the walls' free faces (wallSamplesFromWorld)
+  WallWidth width;                  ///< across the walls' free faces (wallSamplesFromWorld)
 };
 WallFigures wallFigures(const World& world, const PolicyResult& result, double t,
                         const WallProfileOptions& options = WallProfileOptions());

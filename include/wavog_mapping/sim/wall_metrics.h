@@ -27,12 +27,12 @@ struct WallSample {
 
 /// Where and how far the profiles reach.
 struct WallProfileOptions {
-  double spacing_m = 0.5;      ///< distance between samples along a wall (m), > 0
-  double min_length_m = 1.5;   ///< walls (edges) shorter than this are skipped (m)
-  double end_margin_m = 0.5;   ///< no samples this close to an edge's ends (m)
-  double inside_m = 0.5;       ///< the profile reaches this far behind the surface (m)
-  double outside_m = 1.0;      ///< and this far into free space (m)
-  double peak_window_m = 0.25; ///< the peak is looked for this close to the surface (m)
+  double spacing_m = 0.5;       ///< distance between samples along a wall (m), > 0
+  double min_length_m = 1.5;    ///< walls (edges) shorter than this are skipped (m)
+  double end_margin_m = 0.5;    ///< no samples this close to an edge's ends (m)
+  double inside_m = 0.5;        ///< the profile reaches this far behind the surface (m)
+  double outside_m = 1.0;       ///< and this far into free space (m)
+  double peak_window_m = 0.25;  ///< the peak is looked for this close to the surface (m)
 };
 
 /// Samples on the faces of the world's walls (ObjectKind::kWall present at t) that face free
@@ -45,8 +45,8 @@ std::vector<WallSample> wallSamplesFromWorld(const World& world, double t,
 /// principal second moments >= `min_linearity`), at most one per `options.spacing_m` square;
 /// the point is the neighbours' centroid, the normal the minor axis, two-sided.
 std::vector<WallSample> wallSamplesFromMap(const Raster& reference,
-                                           const WallProfileOptions& options,
-                                           double radius_m = 0.4, double min_linearity = 25.0);
+                                           const WallProfileOptions& options, double radius_m = 0.4,
+                                           double min_linearity = 25.0);
 
 /// Width at half maximum of the profiles across the walls.
 struct WallWidth {
