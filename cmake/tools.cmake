@@ -90,3 +90,13 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
                    "playback rostest not registered (set WAVOG_DATA_DIR)")
   endif()
 endif()
+
+# ---- wavog_paper (issue 17): the paper's figures from fr079 (make paper; no ROS at run time) ---
+find_package(CLI11 CONFIG REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+add_executable(wavog_paper src/tools/paper.cpp)
+target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io CLI11::CLI11
+                      nlohmann_json::nlohmann_json Threads::Threads)
+target_compile_options(wavog_paper PRIVATE ${WAVOG_WARNINGS})
+set_target_properties(wavog_paper PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
+install(TARGETS wavog_paper RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
