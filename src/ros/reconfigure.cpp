@@ -1,5 +1,5 @@
-// dynamic_reconfigure <-> Config (see reconfigure.h). Each run-time parameter is named once per
-// direction, here and nowhere else.
+// dynamic_reconfigure <-> Config (see reconfigure.h). Each run-time parameter is named once, in
+// kNumbers (or, for the scales, in the two functions below it), for both directions.
 #include "reconfigure.h"
 
 #include <algorithm>
@@ -7,28 +7,43 @@
 #include <sstream>
 
 namespace wavog_ros {
+namespace {
+
+/// One number of cfg/Mapping.cfg and where it lives in Config; "scales" (a string) is the only
+/// other run-time parameter.
+struct NumberField {
+  double wavog_mapping::MappingConfig::*reconfigure;
+  double& (*in)(Config&);
+};
+
+const NumberField kNumbers[] = {
+    {&wavog_mapping::MappingConfig::gamma, [](Config& c) -> double& { return c.map.policy.gamma; }},
+    {&wavog_mapping::MappingConfig::clamp_min,
+     [](Config& c) -> double& { return c.map.policy.clamp_min; }},
+    {&wavog_mapping::MappingConfig::clamp_max,
+     [](Config& c) -> double& { return c.map.policy.clamp_max; }},
+    {&wavog_mapping::MappingConfig::odd_occ,
+     [](Config& c) -> double& { return c.map.sensor.odd_occ; }},
+    {&wavog_mapping::MappingConfig::odd_emp,
+     [](Config& c) -> double& { return c.map.sensor.odd_emp; }},
+    {&wavog_mapping::MappingConfig::publish_rate,
+     [](Config& c) -> double& { return c.ros.publish_rate; }},
+};
+
+}  // namespace
 
 wavog_mapping::MappingConfig toReconfigure(const Config& config) {
+  Config c = config;
   wavog_mapping::MappingConfig rc;
-  rc.gamma = config.map.policy.gamma;
-  rc.clamp_min = config.map.policy.clamp_min;
-  rc.clamp_max = config.map.policy.clamp_max;
-  rc.odd_occ = config.map.sensor.odd_occ;
-  rc.odd_emp = config.map.sensor.odd_emp;
-  rc.publish_rate = config.ros.publish_rate;
-  rc.scales = joinScales(config.ros.publish_scales);
+  for (const NumberField& f : kNumbers) rc.*f.reconfigure = f.in(c);
+  rc.scales = joinScales(c.ros.publish_scales);
   return rc;
 }
 
 Config withReconfigure(const Config& config, const wavog_mapping::MappingConfig& rc,
                        std::vector<std::string>* errors) {
   Config next = config;
-  next.map.policy.gamma = rc.gamma;
-  next.map.policy.clamp_min = rc.clamp_min;
-  next.map.policy.clamp_max = rc.clamp_max;
-  next.map.sensor.odd_occ = rc.odd_occ;
-  next.map.sensor.odd_emp = rc.odd_emp;
-  next.ros.publish_rate = rc.publish_rate;
+  for (const NumberField& f : kNumbers) f.in(next) = rc.*f.reconfigure;
   if (!parseScales(rc.scales, &next.ros.publish_scales)) {
     errors->push_back("scales ('" + rc.scales + "') must be comma-separated integers");
   }
