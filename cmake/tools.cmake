@@ -47,7 +47,7 @@ endif()
 if(TARGET wavog_offline AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_offline.cpp)
   wavog_tools_test(test_offline)
   target_include_directories(test_offline SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
-  target_link_libraries(test_offline PRIVATE wavog_ros_config ${catkin_LIBRARIES})
+  target_link_libraries(test_offline PRIVATE wavog_ros ${catkin_LIBRARIES})
   target_compile_definitions(test_offline PRIVATE
     WAVOG_LOG2BAG="$<TARGET_FILE:wavog_log2bag>" WAVOG_OFFLINE="$<TARGET_FILE:wavog_offline>")
   add_dependencies(test_offline wavog_log2bag wavog_offline)
