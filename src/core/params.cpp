@@ -40,22 +40,6 @@ bool usesUpperClamp(PolicyType t) {
 
 }  // namespace
 
-const char* toString(ScanStatus status) {
-  switch (status) {
-    case ScanStatus::kOk:
-      return "ok";
-    case ScanStatus::kEmpty:
-      return "empty_scan";
-    case ScanStatus::kBadGeometry:
-      return "bad_geometry";
-    case ScanStatus::kBadPose:
-      return "bad_pose";
-    case ScanStatus::kNoValidBeam:
-      return "no_valid_beam";
-  }
-  return "unknown";
-}
-
 const char* toString(PolicyType type) {
   for (const auto& p : kPolicyNames) {
     if (p.type == type) return p.name;

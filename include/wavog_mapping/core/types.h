@@ -1,4 +1,5 @@
-// Basic value types of the ROS-free core: poses, non-owning scan views, cell indices.
+// Basic value types of the ROS-free core: the planar pose and its algebra, non-owning scan views,
+// cell indices, cell classes and scan statuses.
 // Units are SI (metres, radians, seconds). All types are plain values, safe to copy between threads.
 #ifndef WAVOG_MAPPING_CORE_TYPES_H_
 #define WAVOG_MAPPING_CORE_TYPES_H_
@@ -14,6 +15,16 @@ struct Pose2 {
   double y = 0.0;
   double theta = 0.0;
 };
+
+/// Angle wrapped to (-pi, pi]. The package's one angle wrap.
+double wrapAngle(double a);
+/// Composition a * b: pose b (given relative to frame a) expressed in a's parent frame.
+Pose2 compose(const Pose2& a, const Pose2& b);
+/// The inverse transform of a: inverse(a) * a is the identity.
+Pose2 inverse(const Pose2& a);
+/// Pose at fraction f of the way from a (f = 0) to b (f = 1): linear in position, along the
+/// shorter arc in heading.
+Pose2 interpolate(const Pose2& a, const Pose2& b, double f);
 
 /// A non-owning view of one planar range scan in its sensor frame, laid out like
 /// sensor_msgs/LaserScan: beam i points at bearing angle_min + i * angle_increment.

@@ -3,7 +3,10 @@
 // blocks, so it grows without bound in every direction. Scans are integrated coarse to fine with
 // the configured update policy; exponential forgetting uses lazy tags (ALGORITHM.md section 6).
 // Frames: everything is in the map frame; cell (ix, iy) covers [ix, ix+1) x [iy, iy+1) * resolution.
-// Thread-safety: none. Concurrent const calls are safe; any non-const call needs exclusive access.
+// Thread-safety: a map is not synchronised. Concurrent const calls on one map are safe; any
+// non-const call needs exclusive access to that map. integrate() keeps per-thread scratch buffers
+// (a thread_local, reused from scan to scan), so maps used from different threads never share
+// state, and each thread that integrates holds one scan's buffers for its lifetime.
 #ifndef WAVOG_MAPPING_CORE_WAVELET_MAP_H_
 #define WAVOG_MAPPING_CORE_WAVELET_MAP_H_
 
@@ -26,6 +29,9 @@ struct IntegrateStats {
   std::uint32_t beams_invalid = 0;    ///< NaN, -inf, <= 0, < range_min
   std::uint64_t nodes_visited = 0;    ///< tree nodes and finest cells visited
   std::uint32_t blocks_touched = 0;   ///< blocks classified as not U
+  /// Finest cells within the scan's reach (the farthest E or O limit of its beams): every cell
+  /// the scan changed lies in this box. Empty when status != kOk.
+  CellBox touched;
 };
 
 /// Size and work figures of a map.
