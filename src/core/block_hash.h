@@ -16,7 +16,7 @@ namespace detail {
 /// One hashed block: a quadtree of block_levels levels, its average and its root node.
 struct Block {
   double s = 0.0;          ///< mean log-odds of the block (exact, never lazy)
-  Node root;               ///< valid when has_root
+  Node root{};             ///< valid when has_root
   bool has_root = false;   ///< false: the block is uniform at s
   bool known_all = false;  ///< every cell observed
   bool known_any = false;  ///< some cell observed

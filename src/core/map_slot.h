@@ -65,8 +65,8 @@ class ChildSlot {
 /// slot takes m's knowledge, a stored node that became trivial is deleted and a temporary that
 /// did not is stored. Returns what update returned (the change of the slot's average).
 template <typename Slot, typename Update>
-double refineSlot(Slot& slot, Node* stored, Update update) {
-  Node tmp;
+[[gnu::always_inline]] inline double refineSlot(Slot& slot, Node* stored, Update update) {
+  Node tmp{};
   tmp.known_all = slot.knownAll() ? 0xF : 0;
   tmp.known_any = slot.knownAny() ? 0xF : 0;
   Node& m = stored != nullptr ? *stored : tmp;

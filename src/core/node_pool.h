@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 namespace wavog {
@@ -17,15 +18,18 @@ namespace detail {
 /// One quadtree node at level l >= 1: the three Haar details of its 2x2 children, its children
 /// (a group of 4 node slots in the pool; a missing child is a uniform block), the lazy forgetting
 /// count and what is known of its children. Level-1 nodes have finest cells as children.
+/// A trivial type: `Node{}` is the empty node (all zero); `Node n;` is uninitialised, so that the
+/// pool's chunks need not be cleared (allocate() clears each group it hands out).
 struct Node {
-  float d[3] = {0.f, 0.f, 0.f};  ///< stored details dx, dy, dxy (true = stored * a^(pending k's))
-  std::uint32_t children = 0;    ///< pool group of the 4 child slots; 0 = no child node
-  std::uint8_t k = 0;            ///< pending forgetting steps for this node and its subtree
-  std::uint8_t child_mask = 0;   ///< bit q: child node q exists in the group
-  std::uint8_t known_all = 0;    ///< bit q: every finest cell of child q was observed
-  std::uint8_t known_any = 0;    ///< bit q: some finest cell of child q was observed
+  float d[3];                ///< stored details dx, dy, dxy (true = stored * a^(pending k's))
+  std::uint32_t children;    ///< pool group of the 4 child slots; 0 = no child node
+  std::uint8_t k;            ///< pending forgetting steps for this node and its subtree
+  std::uint8_t child_mask;   ///< bit q: child node q exists in the group
+  std::uint8_t known_all;    ///< bit q: every finest cell of child q was observed
+  std::uint8_t known_any;    ///< bit q: some finest cell of child q was observed
 };
 static_assert(sizeof(Node) == 20, "Node layout grew");
+static_assert(std::is_trivial<Node>::value, "Node must stay trivial (uncleared pool chunks)");
 
 struct NodeGroup {
   Node n[4];

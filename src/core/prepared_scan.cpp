@@ -99,9 +99,10 @@ void PreparedScan::setBeams(const MapParams& params, const ScanView& scan, Integ
   const double clear = params.sensor.no_return_clear;
   const double inf = std::numeric_limits<double>::infinity();
   kind.assign(nu, BeamKind::kInvalid);
-  leaf.assign(nu, LeafTest{});
-  min_e2.assign(nu, inf);  // level 0 of the tables; the levels above are built by buildTables()
-  max_u2.assign(nu, -1.0);
+  leaf.resize(nu);  // every element is written below
+  // Level 0 of the tables is written below, the levels above by buildTables(). Sized once per
+  // scan without clearing (a resize to the same size touches nothing).
+  tableLevels();
   invalid_prefix.assign(nu + 1, 0);
   hits.clear();
   hit_x.assign(nu, 0);
@@ -139,13 +140,19 @@ void PreparedScan::setBeams(const MapParams& params, const ScanView& scan, Integ
   }
 }
 
+int PreparedScan::tableLevels() {
+  int levels = 1;
+  while ((1 << levels) <= n) ++levels;
+  const std::size_t size = static_cast<std::size_t>(levels) * static_cast<std::size_t>(n);
+  min_e2.resize(size);
+  max_u2.resize(size);
+  return levels;
+}
+
 void PreparedScan::buildTables() {
   // Level k holds min / max over [j, j + 2^k); level 0 is filled by setBeams().
   const auto nu = static_cast<std::size_t>(n);
-  int levels = 1;
-  while ((1 << levels) <= n) ++levels;
-  min_e2.resize(static_cast<std::size_t>(levels) * nu);
-  max_u2.resize(static_cast<std::size_t>(levels) * nu);
+  const int levels = tableLevels();
   for (int k = 1; k < levels; ++k) {
     const std::size_t base = static_cast<std::size_t>(k) * nu, prev = base - nu;
     const std::size_t half = std::size_t{1} << (k - 1);

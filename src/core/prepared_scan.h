@@ -107,6 +107,7 @@ struct PreparedScan {
   void setBoundaries();
   void setBeams(const MapParams& params, const ScanView& scan, IntegrateStats* st);
   void buildTables();
+  int tableLevels();  // sizes the tables for n beams; returns their levels
 
   std::vector<float> ranges_;  // work copy, in ascending bearing order
 };

@@ -41,7 +41,7 @@ class Integrator {
   // temporary uniform one) when the slot must be refined, and returns the change of its average.
   // Returns the change of the slot's average.
   template <typename Slot, typename Descend>
-  double updateSlot(Slot& slot, CellClass cls, double s, Descend descend) {
+  [[gnu::always_inline]] double updateSlot(Slot& slot, CellClass cls, double s, Descend descend) {
     Node* node = slot.node();
     switch (cls) {
       case CellClass::kUnknown:

@@ -73,8 +73,6 @@ class ScanClassifier {
   CellClass cellAt(std::size_t j, double d2) const;
   bool isHitCell(std::int64_t ix, std::int64_t iy, const SquareInfo& box) const;
   std::uint32_t hitMask4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const;
-  CellMasks classify4x4Sectors(const double* dx, const double* dy, const double* dx2,
-                               const double* dy2, std::uint32_t hit, const SquareInfo& box) const;
   long beamOf(double dx, double dy) const;
   long beamIn(double dx, double dy, const SquareInfo& box) const;
   int lastSurelyPast(double dx, double dy, double tol, int lo, int hi) const;

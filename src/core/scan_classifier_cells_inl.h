@@ -59,8 +59,8 @@ inline bool ScanClassifier::isHitCell(std::int64_t ix, std::int64_t iy,
 }
 
 /// The cells of the 4 x 4 square at (ix0, iy0) holding a hit endpoint of the square's beams.
-inline std::uint32_t ScanClassifier::hitMask4x4(std::int64_t ix0, std::int64_t iy0,
-                                                const SquareInfo& box) const {
+[[gnu::always_inline]] inline std::uint32_t ScanClassifier::hitMask4x4(
+    std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const {
   std::uint32_t hit = 0;
   for (int j = box.jlo; j <= box.jhi; ++j) {
     const auto ju = static_cast<std::size_t>(j);
@@ -84,29 +84,21 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
     dy2[i] = dy[i] * dy[i];
   }
   const std::uint32_t hit = hitMask4x4(ix0, iy0, box);
-  if (!box.single) return classify4x4Sectors(dx.data(), dy.data(), dx2.data(), dy2.data(), hit, box);
-  // One beam: distances alone.
-  const LeafTest t = s_.leaf[static_cast<std::size_t>(box.jlo)];
-  std::uint32_t e = 0, o = 0;
-  for (unsigned i = 0; i < 16; ++i) {
-    const double d2 = dx2[i & 3] + dy2[i >> 2];
-    e |= static_cast<std::uint32_t>(d2 < t.e) << i;
-    o |= static_cast<std::uint32_t>(d2 <= t.o) << i;
+  if (box.single) {  // one beam: distances alone
+    const LeafTest t = s_.leaf[static_cast<std::size_t>(box.jlo)];
+    std::uint32_t e = 0, o = 0;
+    for (unsigned i = 0; i < 16; ++i) {
+      const double d2 = dx2[i & 3] + dy2[i >> 2];
+      e |= static_cast<std::uint32_t>(d2 < t.e) << i;
+      o |= static_cast<std::uint32_t>(d2 <= t.o) << i;
+    }
+    CellMasks m;
+    m.e = e & ~hit;
+    m.o = (o & ~e) | hit;
+    return m;
   }
-  CellMasks m;
-  m.e = e & ~hit;
-  m.o = (o & ~e) | hit;
-  return m;
-}
-
-/// classify4x4() of a narrow square over a few sectors, given the columns' and rows' offsets
-/// and their squares and the hit mask. Where the distance alone decides (E in every sector of
-/// the square, or U in every one: outside sectors and invalid beams count as U), no sector is
-/// needed.
-inline CellMasks ScanClassifier::classify4x4Sectors(const double* dx, const double* dy,
-                                                    const double* dx2, const double* dy2,
-                                                    std::uint32_t hit,
-                                                    const SquareInfo& box) const {
+  // A few sectors. Where the distance alone decides (E in every sector of the square, or U in
+  // every one: outside sectors and invalid beams count as U), no sector is needed.
   double te_min =
       box.slo < 0 || box.shi > s_.n - 1 ? -1.0 : std::numeric_limits<double>::infinity();
   double te_max = -1.0, tu_max = -1.0;
@@ -175,8 +167,7 @@ inline long ScanClassifier::beamOf(double dx, double dy) const {
 // by more than kRayMargin radians (tol = kRayMargin * (|dx| + |dy|) bounds that from above).
 
 /// Largest k in [lo, hi] such that (dx, dy) is surely past boundary k (lo when none is tested).
-inline int ScanClassifier::lastSurelyPast(double dx, double dy, double tol, int lo,
-                                          int hi) const {
+inline int ScanClassifier::lastSurelyPast(double dx, double dy, double tol, int lo, int hi) const {
   while (lo < hi) {
     const int mid = lo + (hi - lo + 1) / 2;
     const auto m = static_cast<std::size_t>(mid);

@@ -24,6 +24,7 @@ struct PolicyRun {
   std::vector<NamedParams> configs;
   std::vector<std::unique_ptr<WaveletMap>> maps;
   std::unique_ptr<DenseReference> ref;
+  std::vector<std::size_t> integrated;  // per map: scans it integrated (status kOk)
 
   PolicyRun(std::vector<NamedParams> c, const CellBox& extent) : configs(std::move(c)) {
     std::vector<MapParams> layers;
@@ -32,13 +33,20 @@ struct PolicyRun {
       layers.push_back(np.params);
     }
     ref = std::make_unique<DenseReference>(layers, extent);
+    integrated.assign(maps.size(), 0);
   }
   void integrate(const OwnedScan& s) {
-    for (auto& m : maps) m->integrate(s.pose, s.view());
+    for (std::size_t i = 0; i < maps.size(); ++i) {
+      if (maps[i]->integrate(s.pose, s.view()).status == wavog::ScanStatus::kOk) ++integrated[i];
+    }
     ref->integrate(s.pose, s.view());
   }
+  // Equal to the reference, and not vacuously: scans were integrated and cells observed (a
+  // regression that refuses every scan, or changes nothing, fails here).
   void expectEqual(const std::string& when) {
     for (std::size_t i = 0; i < maps.size(); ++i) {
+      EXPECT_GT(integrated[i], 0u) << configs[i].name << " " << when;
+      EXPECT_GT(maps[i]->stats(true).observed_cells, 0u) << configs[i].name << " " << when;
       ref->selectLayer(i);
       const Comparison c = compare(*maps[i], *ref);
       EXPECT_LE(c.max_rel_error, kTolerance)
