@@ -57,24 +57,15 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, In
   return visited + integrator.visited();
 }
 
-std::uint64_t integrateWith(PolicyType type, WaveletMap::Impl& impl, const ScanClassifier& cls,
-                            IntegrateStats* st) {
-  switch (type) {
-    case PolicyType::kNone:
-      return integrateAll<PolicyType::kNone>(impl, cls, st);
-    case PolicyType::kMax:
-      return integrateAll<PolicyType::kMax>(impl, cls, st);
-    case PolicyType::kClamp:
-      return integrateAll<PolicyType::kClamp>(impl, cls, st);
-    case PolicyType::kForget:
-      return integrateAll<PolicyType::kForget>(impl, cls, st);
-    case PolicyType::kClampLower:
-      return integrateAll<PolicyType::kClampLower>(impl, cls, st);
-    case PolicyType::kClampUpper:
-      return integrateAll<PolicyType::kClampUpper>(impl, cls, st);
-  }
-  return 0;
-}
+// One instantiation per policy, in the order of PolicyType's enumerators.
+using IntegrateFn = std::uint64_t (*)(WaveletMap::Impl&, const ScanClassifier&, IntegrateStats*);
+constexpr IntegrateFn kIntegrateFor[] = {
+    &integrateAll<PolicyType::kNone>,       &integrateAll<PolicyType::kMax>,
+    &integrateAll<PolicyType::kClamp>,      &integrateAll<PolicyType::kForget>,
+    &integrateAll<PolicyType::kClampLower>, &integrateAll<PolicyType::kClampUpper>};
+static_assert(static_cast<int>(PolicyType::kNone) == 0 &&
+                  static_cast<int>(PolicyType::kClampUpper) == 5,
+              "kIntegrateFor follows PolicyType's order");
 
 }  // namespace
 
@@ -90,7 +81,8 @@ IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& s
   }
   const detail::PreparedScan& ps = classifier.scan();
   st.touched = reachBox(ps.px, ps.py, ps.reach, ps.res);
-  st.nodes_visited = integrateWith(impl_->params.policy.type, *impl_, classifier, &st);
+  const auto policy = static_cast<std::size_t>(impl_->params.policy.type);
+  st.nodes_visited = kIntegrateFor[policy](*impl_, classifier, &st);
   impl_->nodes_visited_last = st.nodes_visited;
   return st;
 }

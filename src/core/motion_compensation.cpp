@@ -47,7 +47,8 @@ ScanView MotionCompensator::compensate(const ScanView& scan, const Pose2& start,
     const double bearing = scan.angle_min + static_cast<double>(i) * inc;
     const Pose2 pose = interpolate(start, end, static_cast<double>(i) / last);
     Rank rank = kInvalid;
-    double new_bearing = bearing + wrapAngle(pose.theta - reference.theta);  // directions only rotate
+    double new_bearing =
+        bearing + wrapAngle(pose.theta - reference.theta);  // directions only rotate
     float value = r;
     if (std::isnan(r) || r <= 0.0f || static_cast<double>(r) < scan.range_min) {
       rank = kInvalid;

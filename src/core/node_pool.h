@@ -21,12 +21,12 @@ namespace detail {
 /// A trivial type: `Node{}` is the empty node (all zero); `Node n;` is uninitialised, so that the
 /// pool's chunks need not be cleared (allocate() clears each group it hands out).
 struct Node {
-  float d[3];                ///< stored details dx, dy, dxy (true = stored * a^(pending k's))
-  std::uint32_t children;    ///< pool group of the 4 child slots; 0 = no child node
-  std::uint8_t k;            ///< pending forgetting steps for this node and its subtree
-  std::uint8_t child_mask;   ///< bit q: child node q exists in the group
-  std::uint8_t known_all;    ///< bit q: every finest cell of child q was observed
-  std::uint8_t known_any;    ///< bit q: some finest cell of child q was observed
+  float d[3];               ///< stored details dx, dy, dxy (true = stored * a^(pending k's))
+  std::uint32_t children;   ///< pool group of the 4 child slots; 0 = no child node
+  std::uint8_t k;           ///< pending forgetting steps for this node and its subtree
+  std::uint8_t child_mask;  ///< bit q: child node q exists in the group
+  std::uint8_t known_all;   ///< bit q: every finest cell of child q was observed
+  std::uint8_t known_any;   ///< bit q: some finest cell of child q was observed
 };
 static_assert(sizeof(Node) == 20, "Node layout grew");
 static_assert(std::is_trivial<Node>::value, "Node must stay trivial (uncleared pool chunks)");

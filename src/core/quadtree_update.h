@@ -144,8 +144,7 @@ class Integrator {
   // A level-2 node (4 x 4 finest cells, tag flushed): its 16 cells are classified together
   // (cheaply when the square lies in one or a few sectors) and each level-1 child slot takes the
   // class of its 4 cells, exactly, instead of a conservative square test of its own.
-  double visitLevel2(Node& n, const SquareInfo& box, std::int64_t ix0, std::int64_t iy0,
-                     double s) {
+  double visitLevel2(Node& n, const SquareInfo& box, std::int64_t ix0, std::int64_t iy0, double s) {
     const CellMasks cells = cls_.classify4x4(ix0, iy0, box);  // cell (x, y) at bit x + 4 y
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};

@@ -81,8 +81,8 @@ inline SquareInfo ScanClassifier::classifyInRange(int l, std::int64_t ix0, std::
   SquareInfo info = parent;
   double ax, ay, bx, by;
   extremeCorners(sq, &ax, &ay, &bx, &by);
-  info.slo = lastSurelyPast(ax, ay, kRayMargin * (std::fabs(ax) + std::fabs(ay)), parent.slo,
-                            parent.shi);
+  info.slo =
+      lastSurelyPast(ax, ay, kRayMargin * (std::fabs(ax) + std::fabs(ay)), parent.slo, parent.shi);
   info.shi = lastNotSurelyBefore(bx, by, kRayMargin * (std::fabs(bx) + std::fabs(by)), info.slo,
                                  parent.shi);
   info.jlo = std::max(info.slo, 0);

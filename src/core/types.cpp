@@ -2,6 +2,7 @@
 #include "wavog_mapping/core/types.h"
 
 #include <cmath>
+#include <cstddef>
 
 namespace wavog {
 namespace {
@@ -9,19 +10,11 @@ constexpr double kPi = 3.14159265358979323846;
 }  // namespace
 
 const char* toString(ScanStatus status) {
-  switch (status) {
-    case ScanStatus::kOk:
-      return "ok";
-    case ScanStatus::kEmpty:
-      return "empty_scan";
-    case ScanStatus::kBadGeometry:
-      return "bad_geometry";
-    case ScanStatus::kBadPose:
-      return "bad_pose";
-    case ScanStatus::kNoValidBeam:
-      return "no_valid_beam";
-  }
-  return "unknown";
+  // In the order of the enumerators.
+  constexpr const char* kNames[] = {"ok", "empty_scan", "bad_geometry", "bad_pose",
+                                    "no_valid_beam"};
+  const auto i = static_cast<std::size_t>(status);
+  return i < sizeof(kNames) / sizeof(kNames[0]) ? kNames[i] : "unknown";
 }
 
 double wrapAngle(double a) {

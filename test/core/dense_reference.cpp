@@ -44,12 +44,18 @@ double DenseReference::apply(const wavog::MapParams& p, bool occupied, double x)
   const double o = occupied ? p.sensor.odd_occ : p.sensor.odd_emp;
   const double lo = p.policy.clamp_min, hi = p.policy.clamp_max, g = p.policy.gamma;
   switch (p.policy.type) {
-    case PolicyType::kNone: return x + o;                               // eq. 1.2
-    case PolicyType::kMax: return std::max(x, o);                       // eq. 1.4
-    case PolicyType::kClamp: return std::max(std::min(x + o, hi), lo);  // eq. 1.5
-    case PolicyType::kForget: return (1.0 - g) * x + g * o;             // eq. 1.6
-    case PolicyType::kClampLower: return std::max(x + o, lo);
-    case PolicyType::kClampUpper: return std::min(x + o, hi);
+    case PolicyType::kNone:
+      return x + o;  // eq. 1.2
+    case PolicyType::kMax:
+      return std::max(x, o);  // eq. 1.4
+    case PolicyType::kClamp:
+      return std::max(std::min(x + o, hi), lo);  // eq. 1.5
+    case PolicyType::kForget:
+      return (1.0 - g) * x + g * o;  // eq. 1.6
+    case PolicyType::kClampLower:
+      return std::max(x + o, lo);
+    case PolicyType::kClampUpper:
+      return std::min(x + o, hi);
   }
   return x;
 }
@@ -77,8 +83,8 @@ bool ReferenceClassifier::prepare(const wavog::MapParams& p, const wavog::Pose2&
   const double amax = amin_ + inc_ * (static_cast<double>(n_) - 1.0);
   seam_ = 0.5 * (amin_ + amax) - kPi;
   res_ = p.grid.resolution;
-  const double sensor_max = p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max)
-                                                   : scan.range_max;
+  const double sensor_max =
+      p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max) : scan.range_max;
   const double half_band = 0.5 * (p.sensor.band_width > 0 ? p.sensor.band_width : res_);
   const double inf = std::numeric_limits<double>::infinity();
 
@@ -122,7 +128,8 @@ wavog::CellClass ReferenceClassifier::cellClass(std::int64_t ix, std::int64_t iy
   double beta = std::atan2(dy, dx) - pose_.theta;
   beta -= 2 * kPi * std::floor((beta - seam_) / (2 * kPi));
   const long j = std::lround((beta - amin_) / inc_);
-  if (j < 0 || j >= n_ || kind_[static_cast<std::size_t>(j)] == 0) return wavog::CellClass::kUnknown;
+  if (j < 0 || j >= n_ || kind_[static_cast<std::size_t>(j)] == 0)
+    return wavog::CellClass::kUnknown;
   const auto ju = static_cast<std::size_t>(j);
   if (rho < ze_[ju]) return wavog::CellClass::kEmpty;
   if (kind_[ju] == 1 && rho <= zu_[ju]) return wavog::CellClass::kOccupied;
@@ -135,17 +142,22 @@ void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& 
   if (!ref.prepare(p_, pose, scan)) return;
   // Cells farther than every band end are U: visit only the box of radius `reach` (plus a cell).
   const double reach = ref.reach(), res = p_.grid.resolution;
-  const auto x_lo = std::max(extent_.min_x, static_cast<std::int64_t>(std::floor((pose.x - reach) / res)) - 1);
-  const auto x_hi = std::min(extent_.max_x, static_cast<std::int64_t>(std::floor((pose.x + reach) / res)) + 2);
-  const auto y_lo = std::max(extent_.min_y, static_cast<std::int64_t>(std::floor((pose.y - reach) / res)) - 1);
-  const auto y_hi = std::min(extent_.max_y, static_cast<std::int64_t>(std::floor((pose.y + reach) / res)) + 2);
+  const auto x_lo =
+      std::max(extent_.min_x, static_cast<std::int64_t>(std::floor((pose.x - reach) / res)) - 1);
+  const auto x_hi =
+      std::min(extent_.max_x, static_cast<std::int64_t>(std::floor((pose.x + reach) / res)) + 2);
+  const auto y_lo =
+      std::max(extent_.min_y, static_cast<std::int64_t>(std::floor((pose.y - reach) / res)) - 1);
+  const auto y_hi =
+      std::min(extent_.max_y, static_cast<std::int64_t>(std::floor((pose.y + reach) / res)) + 2);
   for (std::int64_t iy = y_lo; iy < y_hi; ++iy) {
     for (std::int64_t ix = x_lo; ix < x_hi; ++ix) {
       const wavog::CellClass cls = ref.cellClass(ix, iy);
       if (cls == wavog::CellClass::kUnknown) continue;
       const bool occupied = cls == wavog::CellClass::kOccupied;
       const std::size_t i = index(ix, iy);
-      for (std::size_t k = 0; k < layers_.size(); ++k) v_[k][i] = apply(layers_[k], occupied, v_[k][i]);
+      for (std::size_t k = 0; k < layers_.size(); ++k)
+        v_[k][i] = apply(layers_[k], occupied, v_[k][i]);
       known_[i] = 1;
       ++last_updated_;
     }

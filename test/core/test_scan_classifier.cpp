@@ -63,7 +63,8 @@ class Walk {
     for (std::int64_t y = iy0; y < iy0 + size; ++y) {
       for (std::int64_t x = ix0; x < ix0 + size; ++x) {
         const CellClass c = ref_.cellClass(x, y);
-        const bool ok = cls == CellClass::kMixed || (cls == CellClass::kEmpty && c == CellClass::kEmpty) ||
+        const bool ok = cls == CellClass::kMixed ||
+                        (cls == CellClass::kEmpty && c == CellClass::kEmpty) ||
                         (cls == CellClass::kUnknown && c == CellClass::kUnknown) ||
                         (cls == CellClass::kFreeOrUnknown && c != CellClass::kOccupied);
         ASSERT_TRUE(ok) << "square l=" << l << " at (" << ix0 << ", " << iy0 << ") class "
@@ -110,14 +111,19 @@ void checkScans(const wavog::MapParams& p, std::uint32_t seed, int count, Seen* 
     ASSERT_EQ(st.beams_hit + st.beams_no_return + st.beams_invalid, s.ranges.size());
     // Every square of side 2^kLevels within the scan's reach (plus one square of margin).
     const double reach = ref.reach() + size * p.grid.resolution;
-    const auto lo_x = static_cast<std::int64_t>(std::floor((s.pose.x - reach) / p.grid.resolution)) / size - 1;
-    const auto hi_x = static_cast<std::int64_t>(std::floor((s.pose.x + reach) / p.grid.resolution)) / size + 1;
-    const auto lo_y = static_cast<std::int64_t>(std::floor((s.pose.y - reach) / p.grid.resolution)) / size - 1;
-    const auto hi_y = static_cast<std::int64_t>(std::floor((s.pose.y + reach) / p.grid.resolution)) / size + 1;
+    const auto lo_x =
+        static_cast<std::int64_t>(std::floor((s.pose.x - reach) / p.grid.resolution)) / size - 1;
+    const auto hi_x =
+        static_cast<std::int64_t>(std::floor((s.pose.x + reach) / p.grid.resolution)) / size + 1;
+    const auto lo_y =
+        static_cast<std::int64_t>(std::floor((s.pose.y - reach) / p.grid.resolution)) / size - 1;
+    const auto hi_y =
+        static_cast<std::int64_t>(std::floor((s.pose.y + reach) / p.grid.resolution)) / size + 1;
     Walk walk(cls, ref, seen);
     for (std::int64_t by = lo_y; by <= hi_y; ++by) {
       for (std::int64_t bx = lo_x; bx <= hi_x; ++bx) {
-        walk.square(kLevels, bx * size, by * size, cls.classifySquare(kLevels, bx * size, by * size));
+        walk.square(kLevels, bx * size, by * size,
+                    cls.classifySquare(kLevels, bx * size, by * size));
         if (::testing::Test::HasFailure()) return;
       }
     }

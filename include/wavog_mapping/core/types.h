@@ -1,6 +1,7 @@
 // Basic value types of the ROS-free core: the planar pose and its algebra, non-owning scan views,
 // cell indices, cell classes and scan statuses.
-// Units are SI (metres, radians, seconds). All types are plain values, safe to copy between threads.
+// Units are SI (metres, radians, seconds). All types are plain values, safe to copy between
+// threads.
 #ifndef WAVOG_MAPPING_CORE_TYPES_H_
 #define WAVOG_MAPPING_CORE_TYPES_H_
 
@@ -70,10 +71,10 @@ enum class CellClass : std::uint8_t {
 /// Why a whole scan was refused by the core (it then changes nothing).
 enum class ScanStatus : std::uint8_t {
   kOk,
-  kEmpty,           ///< no beams
-  kBadGeometry,     ///< angle_increment zero or non-finite, field of view > 2 pi, bad range limits
-  kBadPose,         ///< non-finite sensor pose
-  kNoValidBeam,     ///< every beam is invalid: nothing to integrate (map unchanged)
+  kEmpty,        ///< no beams
+  kBadGeometry,  ///< angle_increment zero or non-finite, field of view > 2 pi, bad range limits
+  kBadPose,      ///< non-finite sensor pose
+  kNoValidBeam,  ///< every beam is invalid: nothing to integrate (map unchanged)
 };
 
 /// Human-readable name of a ScanStatus, for logs and counters.
