@@ -144,7 +144,7 @@ TEST(ScanClassifier, RandomScansMatchTheCellByCellReference) {
   wavog::MapParams p;
   p.grid.resolution = 0.1;
   Seen seen;
-  checkScans(p, 77u, 40, &seen);
+  checkScans(p, 77u, 120, &seen);
   expectEveryClassSeen(seen, "default sensor model");
 }
 
@@ -155,7 +155,7 @@ TEST(ScanClassifier, ClearingNoReturnsWideBandAndMaxRange) {
   p.sensor.band_width = 0.35;
   p.sensor.max_range = 2.8;  // some returns beyond it count as no return
   Seen seen;
-  checkScans(p, 4242u, 40, &seen);
+  checkScans(p, 4242u, 120, &seen);
   expectEveryClassSeen(seen, "clearing");
   EXPECT_GT(seen.squares[static_cast<std::size_t>(CellClass::kFreeOrUnknown)], 0u);
 }
