@@ -8,6 +8,7 @@ add_library(wavog_sim STATIC
   src/sim/geometry.cpp src/sim/world.cpp src/sim/world_file.cpp src/sim/laser_sim.cpp
   src/sim/ground_truth.cpp src/sim/pose_noise.cpp src/sim/wall_metrics.cpp)
 target_link_libraries(wavog_sim PUBLIC wavog_core PRIVATE yaml-cpp)
+target_include_directories(wavog_sim SYSTEM PUBLIC ${EIGEN3_INCLUDE_DIR})
 target_compile_options(wavog_sim PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_sim PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
