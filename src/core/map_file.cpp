@@ -56,8 +56,8 @@ int createTemporary(const std::string& path, std::string* tmp) {
       throw MapIoError("cannot create a temporary map file '" + name + "': " + errnoText());
     }
   }
-  throw MapIoError("cannot create a temporary map file beside '" + path + "': " +
-                   std::to_string(kAttempts) + " names taken");
+  throw MapIoError("cannot create a temporary map file beside '" + path +
+                   "': " + std::to_string(kAttempts) + " names taken");
 }
 
 void writeAll(int fd, const std::vector<unsigned char>& data, const std::string& name) {

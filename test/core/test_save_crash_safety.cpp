@@ -98,8 +98,8 @@ TEST(SaveCrashSafety, KillNineDuringSaveLeavesTheOldOrTheNewMap) {
     ASSERT_EQ(::kill(child, SIGKILL), 0);
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
-    ASSERT_TRUE(WIFSIGNALED(status)) << "the child stopped by itself (a save threw), status "
-                                     << status;
+    ASSERT_TRUE(WIFSIGNALED(status))
+        << "the child stopped by itself (a save threw), status " << status;
 
     const auto now = readAll(path);
     if (now == bytes_a) {

@@ -160,7 +160,8 @@ std::vector<Raster> readOut(const WaveletMap& map) {
     if (!map.bounds(s, &box)) break;
     if (wavog_fuzz::readOutGuarded(box.width(), box.height())) continue;  // known finding
     Raster r = map.exportScale(s, box, Aggregation::kMean);
-    const auto cells = static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
+    const auto cells =
+        static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
     WAVOG_FUZZ_CHECK(r.log_odds.size() == cells && r.known.size() == cells,
                      "scale %d: %zu cells for a %lld x %lld window", s, r.log_odds.size(),
                      static_cast<long long>(box.width()), static_cast<long long>(box.height()));
@@ -204,7 +205,8 @@ void runOracle(const Case& c, WaveletMap* map) {
 double reachOf(const MapParams& p, const Scan& s) {
   const double sensor_max =
       p.sensor.max_range > 0 ? std::min(p.sensor.max_range, s.range_max) : s.range_max;
-  const double half_band = 0.5 * (p.sensor.band_width > 0 ? p.sensor.band_width : p.grid.resolution);
+  const double half_band =
+      0.5 * (p.sensor.band_width > 0 ? p.sensor.band_width : p.grid.resolution);
   double reach = 0;
   for (float r : s.ranges) {
     const double z = r;
@@ -267,8 +269,8 @@ void describe(const Case& c) {
     for (float r : s.ranges) std::fprintf(stderr, " %.9g", static_cast<double>(r));
     std::fprintf(stderr, "\n");
   }
-  std::fprintf(stderr, "  clearBox [%.17g, %.17g] x [%.17g, %.17g]\n", c.clear.min_x,
-               c.clear.max_x, c.clear.min_y, c.clear.max_y);
+  std::fprintf(stderr, "  clearBox [%.17g, %.17g] x [%.17g, %.17g]\n", c.clear.min_x, c.clear.max_x,
+               c.clear.min_y, c.clear.max_y);
 }
 
 }  // namespace
@@ -314,8 +316,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   WaveletMap loaded(c.params);
   loaded.load(path);
   const auto again = readOut(loaded);
-  WAVOG_FUZZ_CHECK(rasters.size() == again.size(), "round trip: %zu vs %zu rasters",
-                   rasters.size(), again.size());
+  WAVOG_FUZZ_CHECK(rasters.size() == again.size(), "round trip: %zu vs %zu rasters", rasters.size(),
+                   again.size());
   for (std::size_t i = 0; i < rasters.size(); ++i) {
     WAVOG_FUZZ_CHECK(sameBits(rasters[i], again[i]), "round trip: raster %zu differs", i);
   }

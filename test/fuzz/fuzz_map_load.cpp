@@ -40,8 +40,8 @@ std::vector<std::uint8_t> frame(const std::uint8_t* body, std::size_t size) {
 // valid (otherwise the load is refused at once, which is tested as well).
 MapParams paramsFor(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
   const int policy = (mode >> 1) & 3;
-  MapParams p = MapParams::defaultsFor(policy == 0 ? wavog::PolicyType::kClamp
-                                                   : wavog::PolicyType::kForget);
+  MapParams p =
+      MapParams::defaultsFor(policy == 0 ? wavog::PolicyType::kClamp : wavog::PolicyType::kForget);
   static const double kGamma[] = {0.3, 0.3, 0.5, 1.0};
   p.policy.gamma = kGamma[policy];
   if (file.size() >= 24) {
@@ -71,7 +71,8 @@ std::vector<Raster> readOut(const WaveletMap& map) {
     if (wavog_fuzz::readOutGuarded(box.width(), box.height())) continue;  // known finding
     for (Aggregation agg : {Aggregation::kMean, Aggregation::kMax}) {
       Raster r = map.exportScale(s, box, agg);
-      const auto cells = static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
+      const auto cells =
+          static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
       WAVOG_FUZZ_CHECK(r.log_odds.size() == cells && r.known.size() == cells,
                        "scale %d: raster of %zu cells for a %lld x %lld window", s,
                        r.log_odds.size(), static_cast<long long>(box.width()),
@@ -93,8 +94,8 @@ std::vector<Raster> readOut(const WaveletMap& map) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   const std::uint8_t mode = data[0];
-  const std::vector<std::uint8_t> file = (mode & 1) ? frame(data + 1, size - 1)
-                                                    : std::vector<std::uint8_t>(data + 1, data + size);
+  const std::vector<std::uint8_t> file =
+      (mode & 1) ? frame(data + 1, size - 1) : std::vector<std::uint8_t>(data + 1, data + size);
   const MapParams params = paramsFor(file, mode);
   static const std::string path = wavog_fuzz::scratchPath("load.wavog");
   static const std::string again_path = wavog_fuzz::scratchPath("again.wavog");

@@ -37,15 +37,14 @@ inline void writeFile(const std::string& path, const std::uint8_t* data, std::si
 }
 
 /// An oracle violation: prints and aborts, so libFuzzer records the input as a crash.
-#define WAVOG_FUZZ_CHECK(cond, ...)                                         \
-  do {                                                                      \
-    if (!(cond)) {                                                          \
-      std::fprintf(stderr, "oracle failed: %s (%s:%d)\n  ", #cond, __FILE__, \
-                   __LINE__);                                               \
-      std::fprintf(stderr, __VA_ARGS__);                                    \
-      std::fprintf(stderr, "\n");                                           \
-      std::abort();                                                         \
-    }                                                                       \
+#define WAVOG_FUZZ_CHECK(cond, ...)                                                     \
+  do {                                                                                  \
+    if (!(cond)) {                                                                      \
+      std::fprintf(stderr, "oracle failed: %s (%s:%d)\n  ", #cond, __FILE__, __LINE__); \
+      std::fprintf(stderr, __VA_ARGS__);                                                \
+      std::fprintf(stderr, "\n");                                                       \
+      std::abort();                                                                     \
+    }                                                                                   \
   } while (0)
 
 /// Guards that keep the harnesses off input classes with a known, reported core finding whose fix
