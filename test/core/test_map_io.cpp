@@ -24,8 +24,9 @@ using wavog::MapIoError;
 using wavog::MapParams;
 using wavog::WaveletMap;
 
+// Per process, so that two builds running this test at once do not share files.
 std::string tempPath(const std::string& name) {
-  return ::testing::TempDir() + "wavog_io_" + name;
+  return ::testing::TempDir() + "wavog_io_" + std::to_string(::getpid()) + "_" + name;
 }
 
 std::vector<char> readAll(const std::string& path) {
