@@ -63,8 +63,9 @@ inline bool guardsOn() {
 /// through a null pointer (UBSan: "applying non-zero offset ... to null pointer" in
 /// RasterWriter::fill, readout.cpp); blocks 2^20 apart ask for 2^46 bytes (bad_alloc /
 /// length_error in a release build). Until the core bounds its read-out, windows above this many
-/// cells are not read out. The limit is the harness's, not the core's: remove it with the fix.
-constexpr double kReadOutGuardCells = 1 << 20;
+/// cells (1 MiB of floats; larger ones would mostly cost instrumented fill loops) are not read
+/// out. The limit is the harness's, not the core's: remove it with the fix.
+constexpr double kReadOutGuardCells = 1 << 18;
 inline bool readOutGuarded(std::int64_t width, std::int64_t height) {
   return guardsOn() &&
          static_cast<double>(width) * static_cast<double>(height) > kReadOutGuardCells;
