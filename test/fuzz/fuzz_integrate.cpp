@@ -231,6 +231,11 @@ const char* knownScanFinding(const MapParams& p, const Scan& s) {
       (std::fabs(s.pose.y) + reach) / res > kCellLimit) {
     return "pose or reach beyond 2^40 cells";
   }
+  // Finding F5: a finite but huge angle_min (1.1e308) turns the bearing arithmetic into inf - inf
+  // and the NaN reaches a float-to-long cast (scan_integrator.cpp, classifyBox's beamRange:
+  // "-nan is outside the range of representable values of type 'long'").
+  constexpr double kAngleLimit = 1e6;  // rad
+  if (!(std::fabs(s.angle_min) <= kAngleLimit)) return "angle_min beyond 1e6 rad";
   // Finding H1 (issue 16, "hang"): the block loop covers (2 reach / block size)^2 blocks.
   constexpr double kReachBlocks = 256.0;
   if (reach / std::ldexp(res, p.grid.block_levels) > kReachBlocks) return "reach beyond 256 blocks";
