@@ -4,7 +4,8 @@ find_package(GTest REQUIRED)
 find_package(Threads REQUIRED)
 
 add_library(wavog_test_support STATIC test/core/dense_reference.cpp test/core/test_support.cpp)
-target_link_libraries(wavog_test_support PUBLIC wavog_core wavog_io GTest::GTest Threads::Threads)
+target_link_libraries(wavog_test_support PUBLIC wavog_core wavog_io GTest::GTest Threads::Threads
+  ZLIB::ZLIB)
 target_include_directories(wavog_test_support PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/test/core)
 target_compile_options(wavog_test_support PRIVATE ${WAVOG_WARNINGS})
 target_compile_definitions(wavog_test_support PUBLIC
@@ -28,6 +29,7 @@ wavog_core_test(test_reference_equivalence)
 wavog_core_test(test_lazy_forgetting)
 wavog_core_test(test_readout)
 wavog_core_test(test_map_io)
+wavog_core_test(test_save_crash_safety)
 wavog_core_test(test_carmen_reader)
 wavog_core_test(test_motion_compensation)
 wavog_core_test(test_scan_classifier)

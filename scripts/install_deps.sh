@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what wavog_mapping needs from Debian 12's archive. Idempotent: when every package is
-# already installed it returns in well under a second without touching the network.
+# Installs what wavog_mapping needs from Debian 12's archive (with `fuzz`: what make fuzz needs
+# too). Idempotent: when every package is already installed it returns in well under a second
+# without touching the network.
 set -euo pipefail
 
 PKGS=(
@@ -16,6 +17,10 @@ PKGS=(
   ros-message-generation ros-message-runtime
   libcli11-dev nlohmann-json3-dev python3-matplotlib python3-numpy
 )
+# `install_deps.sh fuzz` (make fuzz): clang and its libFuzzer / sanitizer runtimes as well.
+if [ "${1:-}" = fuzz ]; then
+  PKGS+=(clang-14 libclang-rt-14-dev)
+fi
 
 missing=()
 for p in "${PKGS[@]}"; do

@@ -7,17 +7,18 @@
 //   u32 CRC-32 (IEEE) of every byte before it.
 // Stored details and lazy counts are written as they are, so a round trip is bit-exact; a map
 // loaded under another gamma applies the file's pending tags while loading.
+// Files are written and read through map_file.h (exclusive temporary + rename, regular files only).
+#include <algorithm>
 #include <array>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "map_file.h"
 #include "map_impl.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
@@ -29,6 +30,11 @@ using detail::Node;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
 constexpr std::uint32_t kVersion = 1;
+// Fixed header: magic, version, resolution, block_levels, prior, forgetting factor, block count.
+constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
+constexpr std::size_t kCrcBytes = 4;
+constexpr std::size_t kMinBlockBytes = 4 + 4 + 8 + 1;  // bx, by, average, flags
+constexpr std::size_t kNodeBytes = 3 * 4 + 4;          // three details, k, mask, known bits
 
 std::uint32_t crc32(const unsigned char* data, std::size_t size) {
   static const std::array<std::uint32_t, 256> table = [] {
@@ -121,6 +127,43 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, double file_a, int pending
   }
 }
 
+// Opens `path` (a regular file only) and reads it whole, once its header says it is a map of this
+// format whose size fits its block count at `levels` (the map's block_levels, which the file must
+// match): a file larger than its blocks could fill is refused before it is read.
+std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
+  const detail::RegularFile file(path);
+  const auto fail = [&](const std::string& why) {
+    return MapIoError("map file '" + path + "' rejected: " + why);
+  };
+  const std::uint64_t size = file.size();
+  const auto head =
+      file.read(0, static_cast<std::size_t>(std::min<std::uint64_t>(size, kHeaderBytes)));
+  if (head.size() < sizeof(kMagic) + 4 || std::memcmp(head.data(), kMagic, sizeof(kMagic)) != 0) {
+    throw fail("not a wavog map (bad magic)");
+  }
+  std::uint32_t version;
+  std::memcpy(&version, head.data() + sizeof(kMagic), sizeof(version));
+  if (version != kVersion) {
+    throw fail("format version " + std::to_string(version) + ", this build reads version " +
+               std::to_string(kVersion));
+  }
+  if (size < kHeaderBytes + kCrcBytes) throw fail("truncated (" + std::to_string(size) + " bytes)");
+  std::uint64_t count;
+  std::memcpy(&count, head.data() + kHeaderBytes - sizeof(count), sizeof(count));
+  // A full block: its header and one node per level-l node of the quadtree, (4^L - 1) / 3.
+  const double nodes_per_block = (std::ldexp(1.0, 2 * levels) - 1.0) / 3.0;
+  const double largest = static_cast<double>(kHeaderBytes + kCrcBytes) +
+                         static_cast<double>(count) *
+                             (static_cast<double>(kMinBlockBytes) + nodes_per_block * kNodeBytes);
+  if (static_cast<double>(size) > largest) {
+    throw fail(std::to_string(size) + " bytes, more than its " + std::to_string(count) +
+               " blocks can fill (at most " + std::to_string(static_cast<std::uint64_t>(largest)) +
+               " bytes at block_levels " + std::to_string(levels) + ")");
+  }
+  if (size > std::numeric_limits<std::size_t>::max()) throw fail("too large to read");
+  return file.read(0, static_cast<std::size_t>(size));
+}
+
 }  // namespace
 
 void WaveletMap::save(const std::string& path) const {
@@ -146,46 +189,17 @@ void WaveletMap::save(const std::string& path) const {
   const std::uint32_t crc = crc32(buf.data(), buf.size());
   w.put(crc);
 
-  // Temporary file in the same directory, then an atomic rename over the target.
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw MapIoError("cannot write map file '" + tmp + "': " + std::strerror(errno));
-    out.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw MapIoError("cannot write map file '" + tmp + "': write failed (disk full?)");
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw MapIoError("cannot rename '" + tmp + "' to '" + path + "': " + why);
-  }
+  detail::writeFileAtomically(path, buf);
 }
 
 void WaveletMap::load(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw MapIoError("cannot open map file '" + path + "': " + std::strerror(errno));
-  const std::vector<unsigned char> data((std::istreambuf_iterator<char>(in)),
-                                        std::istreambuf_iterator<char>());
+  const std::vector<unsigned char> data = readMapFile(path, impl_->levels);
   const auto fail = [&](const std::string& why) {
     return MapIoError("map file '" + path + "' rejected: " + why);
   };
-  if (data.size() < sizeof(kMagic) + 4 || std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
-    throw fail("not a wavog map (bad magic)");
-  }
-  Reader header(data.data() + sizeof(kMagic), data.size() - sizeof(kMagic));
-  const auto version = header.get<std::uint32_t>();
-  if (version != kVersion) {
-    throw fail("format version " + std::to_string(version) + ", this build reads version " +
-               std::to_string(kVersion));
-  }
-  if (data.size() < sizeof(kMagic) + 4 + 4) throw fail("truncated");
-  const std::size_t body = data.size() - 4;
+  const std::size_t body = data.size() - kCrcBytes;
   std::uint32_t stored_crc;
-  std::memcpy(&stored_crc, data.data() + body, 4);
+  std::memcpy(&stored_crc, data.data() + body, kCrcBytes);
   if (crc32(data.data(), body) != stored_crc) {
     throw fail("checksum mismatch (truncated or corrupted)");
   }
@@ -205,6 +219,10 @@ void WaveletMap::load(const std::string& path) {
       throw fail(s.str());
     }
     const auto count = r.get<std::uint64_t>();
+    if (count > (data.size() - kHeaderBytes - kCrcBytes) / kMinBlockBytes) {
+      throw std::runtime_error(std::to_string(count) + " blocks cannot fit in " +
+                               std::to_string(data.size()) + " bytes");
+    }
     for (std::uint64_t i = 0; i < count; ++i) {
       const auto bx = r.get<std::int32_t>();
       const auto by = r.get<std::int32_t>();

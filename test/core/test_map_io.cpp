@@ -1,9 +1,18 @@
 // Save / load: exact round trip; truncated, corrupted, foreign and mismatched files rejected with
-// the map left unchanged.
+// the map left unchanged; no symlink followed on save; regular files only, size bound by the header.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
 
+#include <cerrno>
+#include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <future>
 #include <iterator>
 
 #include "test_support.h"
@@ -15,8 +24,9 @@ using wavog::MapIoError;
 using wavog::MapParams;
 using wavog::WaveletMap;
 
+// Per process, so that two builds running this test at once do not share files.
 std::string tempPath(const std::string& name) {
-  return ::testing::TempDir() + "wavog_io_" + name;
+  return ::testing::TempDir() + "wavog_io_" + std::to_string(::getpid()) + "_" + name;
 }
 
 std::vector<char> readAll(const std::string& path) {
@@ -128,13 +138,153 @@ TEST(MapIo, BadFilesAreRejectedAndTheMapIsUnchanged) {
   std::remove(good.c_str());
 }
 
+// Files in the directory of `path` whose name starts with its file name followed by ".tmp".
+std::vector<std::string> temporariesOf(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> out;
+  const std::string prefix = fs::path(path).filename().string() + ".tmp";
+  for (const auto& e : fs::directory_iterator(fs::path(path).parent_path())) {
+    if (e.path().filename().string().rfind(prefix, 0) == 0) out.push_back(e.path().string());
+  }
+  return out;
+}
+
 TEST(MapIo, SaveLeavesNoTemporaryAndFailsClearly) {
   WaveletMap map(params());
   fill(&map, 8);
   const std::string path = tempPath("atomic.wavog");
   map.save(path);
-  EXPECT_FALSE(std::ifstream(path + ".tmp").good());
-  EXPECT_THROW(map.save("/nonexistent_dir_wavog/x.wavog"), MapIoError);
+  EXPECT_TRUE(temporariesOf(path).empty());
+  map.save(path);  // over an existing map
+  EXPECT_TRUE(temporariesOf(path).empty());
+  try {
+    map.save("/nonexistent_dir_wavog/x.wavog");
+    ADD_FAILURE() << "save into a missing directory succeeded";
+  } catch (const MapIoError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent_dir_wavog/x.wavog"), std::string::npos)
+        << e.what();
+  }
+  std::remove(path.c_str());
+}
+
+// The temporary used to be the predictable `<path>.tmp`, opened with truncation: a symlink
+// planted there made save() overwrite the file it pointed to.
+TEST(MapIo, SaveDoesNotFollowASymlinkAtTheOldTemporaryName) {
+  WaveletMap map(params());
+  fill(&map, 9);
+  const std::string path = tempPath("planted.wavog");
+  const std::string victim = tempPath("victim.txt");
+  const std::vector<char> precious = {'k', 'e', 'e', 'p', '\n'};
+  writeAll(victim, precious);
+  std::remove((path + ".tmp").c_str());
+  ASSERT_EQ(::symlink(victim.c_str(), (path + ".tmp").c_str()), 0) << std::strerror(errno);
+
+  map.save(path);
+  EXPECT_EQ(readAll(victim), precious) << "the symlink's target was written";
+  WaveletMap loaded(params());
+  loaded.load(path);
+  expectSameMap(map, loaded);
+  char target[512] = {};
+  ASSERT_GT(::readlink((path + ".tmp").c_str(), target, sizeof(target) - 1), 0);
+  EXPECT_EQ(std::string(target), victim) << "the planted link itself is left alone";
+  EXPECT_EQ(temporariesOf(path).size(), 1u) << "only the planted link remains";
+
+  // A symlink at the target itself is replaced by the map, never written through.
+  const std::string linked = tempPath("linked.wavog");
+  std::remove(linked.c_str());
+  ASSERT_EQ(::symlink(victim.c_str(), linked.c_str()), 0);
+  map.save(linked);
+  EXPECT_EQ(readAll(victim), precious);
+  struct stat st {};
+  ASSERT_EQ(::lstat(linked.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISREG(st.st_mode));
+  for (const auto& f : {path, path + ".tmp", victim, linked}) std::remove(f.c_str());
+}
+
+// Loads a path expected to be refused at once; returns the message.
+std::string refusal(WaveletMap* map, const std::string& path) {
+  try {
+    map->load(path);
+  } catch (const MapIoError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << path << " was accepted";
+  return "";
+}
+
+TEST(MapIo, LoadRefusesWhatIsNotARegularFile) {
+  WaveletMap map(params());
+  fill(&map, 10);
+  WaveletMap copy(params());
+  fill(&copy, 10);
+
+  // A directory.
+  const std::string dir = tempPath("a_directory");
+  std::filesystem::create_directories(dir);
+  std::string why = refusal(&map, dir);
+  EXPECT_NE(why.find("a directory"), std::string::npos) << why;
+  EXPECT_NE(why.find(dir), std::string::npos) << why;
+
+  // /dev/zero: endless bytes (it used to be read until memory ran out).
+  why = refusal(&map, "/dev/zero");
+  EXPECT_NE(why.find("character device"), std::string::npos) << why;
+
+  // A FIFO without a writer: opening it for reading used to block for ever. The load runs on
+  // another thread; if it blocks, a writer is opened after a generous wait to release it, and the
+  // test fails.
+  const std::string fifo = tempPath("a_fifo");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  auto pending = std::async(std::launch::async, [&] { return refusal(&map, fifo); });
+  if (pending.wait_for(std::chrono::seconds(20)) != std::future_status::ready) {
+    ADD_FAILURE() << "load() blocked on a FIFO";
+    const int w = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (w >= 0) ::close(w);
+  }
+  why = pending.get();
+  EXPECT_NE(why.find("FIFO"), std::string::npos) << why;
+  EXPECT_NE(why.find(fifo), std::string::npos) << why;
+
+  expectSameMap(map, copy);
+  std::remove(fifo.c_str());
+  std::filesystem::remove(dir);
+}
+
+// The header's block count bounds the file size both ways; a file outside the bounds is refused
+// before its content is parsed (a larger one before it is read).
+TEST(MapIo, FileSizeIsBoundByTheHeadersBlockCount) {
+  WaveletMap source(params());
+  fill(&source, 11);
+  const std::string path = tempPath("bounded.wavog");
+  source.save(path);
+  const auto bytes = readAll(path);
+  constexpr std::size_t kCountAt = 8 + 4 + 8 + 4 + 8 + 8;  // u64 block count in the header
+
+  const auto withCount = [&](std::uint64_t count, std::size_t extra) {
+    std::vector<char> out(bytes.begin(), bytes.end() - 4);
+    std::memcpy(out.data() + kCountAt, &count, sizeof(count));
+    out.resize(out.size() + extra, '\0');
+    const auto crc = static_cast<std::uint32_t>(
+        ::crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
+    const auto* c = reinterpret_cast<const char*>(&crc);
+    out.insert(out.end(), c, c + 4);
+    return out;
+  };
+  WaveletMap target(params());
+  // No block, a megabyte of content.
+  writeAll(path, withCount(0, 1 << 20));
+  std::string why = refusal(&target, path);
+  EXPECT_NE(why.find("more than its 0 blocks can fill"), std::string::npos) << why;
+  // More blocks than the bytes can hold.
+  writeAll(path, withCount(std::uint64_t{1} << 60, 0));
+  why = refusal(&target, path);
+  EXPECT_NE(why.find("blocks cannot fit"), std::string::npos) << why;
+  // The recomputed checksum alone does not make the original count wrong: it still loads.
+  std::uint64_t count;
+  std::memcpy(&count, bytes.data() + kCountAt, sizeof(count));
+  writeAll(path, withCount(count, 0));
+  target.load(path);
+  expectSameMap(source, target);
   std::remove(path.c_str());
 }
 

@@ -114,11 +114,14 @@ class WaveletMap {
   /// to never observed.
   void clearBox(double min_x, double min_y, double max_x, double max_y);
 
-  /// Writes the map (versioned binary, CRC-32 checked) to `path` through a temporary file and a
-  /// rename, so a crash never leaves a half-written map. Throws MapIoError.
+  /// Writes the map (versioned binary, CRC-32 checked) to `path` through a new temporary file in
+  /// the same directory (created exclusively, never through a symlink), synced, then renamed over
+  /// `path`: a crash or kill -9 leaves the old file or the complete new one. Throws MapIoError.
   void save(const std::string& path) const;
-  /// Replaces the map by the one in `path`. A missing, truncated, corrupted or foreign file, or one
-  /// with another resolution or block size, throws MapIoError and leaves this map unchanged.
+  /// Replaces the map by the one in `path`, a regular file (a directory, FIFO or device is refused
+  /// at once, without blocking). A missing, truncated, corrupted or foreign file, one larger than
+  /// its header's block count allows, or one with another resolution or block size, throws
+  /// MapIoError naming the file and the reason, and leaves this map unchanged.
   void load(const std::string& path);
 
   /// Counts; `count_observed` also walks the tree to count observed cells (O(nodes)).

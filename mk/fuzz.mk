@@ -1,0 +1,19 @@
+# make fuzz: the libFuzzer harnesses of test/fuzz under ASan + UBSan (float-cast-overflow
+# included, any report stops the run), each for FUZZ_SECONDS (default 60), in their own
+# core-only clang tree. A crash leaves its input in build-fuzz/artifacts/<harness>/.
+BUILD_FUZZ ?= $(ROOT)/build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_CXX ?= $(shell command -v clang++-14 || command -v clang++)
+FUZZ_CC ?= $(shell command -v clang-14 || command -v clang)
+
+.PHONY: fuzz
+## libFuzzer harnesses (map loader, CARMEN reader, scan integration), FUZZ_SECONDS each.
+fuzz:
+	@bash $(ROOT)/scripts/install_deps.sh fuzz
+	@mkdir -p $(BUILD_FUZZ)
+	@cmake -S $(ROOT) -B $(BUILD_FUZZ) -DCMAKE_CXX_COMPILER=$(FUZZ_CXX) -DCMAKE_C_COMPILER=$(FUZZ_CC) \
+	  $(CMAKE_ARGS) -DWAVOG_BUILD_ROS=OFF -DWAVOG_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DWAVOG_SANITIZE="address;undefined;float-cast-overflow;fuzzer-no-link" \
+	  >$(BUILD_FUZZ)/configure.log || { cat $(BUILD_FUZZ)/configure.log; exit 1; }
+	@bash $(ROOT)/scripts/build.sh $(BUILD_FUZZ) $(JOBS) fuzzers
+	@bash $(ROOT)/scripts/run_fuzz.sh $(BUILD_FUZZ) $(FUZZ_SECONDS)

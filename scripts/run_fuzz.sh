@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Runs each libFuzzer harness of a fuzz build tree for SECONDS: scripts/run_fuzz.sh BUILD SECONDS
+# [HARNESS...]. Seeds come from test/fuzz/corpus/<harness>/ (read only); what the run finds goes
+# to BUILD/corpus/<harness>/ (kept between runs), a crashing input to BUILD/artifacts/<harness>/.
+# Prints executions, seconds and exec/s per harness; exit status non-zero if any harness failed.
+set -uo pipefail
+build=${1:?usage: run_fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
+seconds=${2:?usage: run_fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
+shift 2
+root=$(cd "$(dirname "$0")/.." && pwd)
+harnesses=("$@")
+[ ${#harnesses[@]} -eq 0 ] && harnesses=(fuzz_map_load fuzz_carmen fuzz_integrate)
+
+# Leaks count as findings; UBSan already aborts (-fno-sanitize-recover=all).
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:allocator_may_return_null=0}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+failed=0
+summary=()
+for h in "${harnesses[@]}"; do
+  bin=$build/fuzz/$h
+  seeds=$root/test/fuzz/corpus/$h
+  work=$build/corpus/$h
+  artifacts=$build/artifacts/$h/
+  log=$build/fuzz_$h.log
+  mkdir -p "$work" "$artifacts"
+  # -timeout: one input taking longer is a hang finding; -rss_limit_mb / -malloc_limit_mb: one
+  # input needing more memory is a finding too (the machine is shared).
+  "$bin" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+    -print_final_stats=1 -artifact_prefix="$artifacts" "$work" "$seeds" >"$log" 2>&1
+  status=$?
+  execs=$(grep -Eo 'stat::number_of_executed_units: *[0-9]+' "$log" | grep -Eo '[0-9]+$' | tail -1)
+  rate=$(grep -Eo 'stat::average_exec_per_sec: *[0-9]+' "$log" | grep -Eo '[0-9]+$' | tail -1)
+  secs=$(grep -Eo 'Done [0-9]+ runs in [0-9]+ second' "$log" | grep -Eo '[0-9]+ second' | grep -Eo '[0-9]+' | tail -1)
+  if [ "$status" -ne 0 ]; then
+    failed=1
+    echo "fuzz: $h FAILED (status $status); log $log, input in $artifacts:" >&2
+    grep -E 'ERROR|runtime error|oracle failed|SUMMARY|Test unit written' "$log" | head -20 >&2
+  fi
+  summary+=("$(printf '%-16s %s  %12s executions  %5s s  %8s exec/s' "$h" \
+    "$([ "$status" -eq 0 ] && echo clean || echo FAILED)" "${execs:-?}" "${secs:-?}" "${rate:-?}")")
+done
+printf '%s\n' "${summary[@]}"
+exit "$failed"

@@ -1,0 +1,334 @@
+// libFuzzer harness: scan integration with map parameters, poses, beam geometry, ranges and
+// clearBox bounds decoded from the bytes (NaN, +-inf, -0, denormals, 1e300, FLT_MAX, ...), then a
+// read-out at every scale, stats, save and load.
+// Two modes, chosen by the first decoded bit:
+//  - oracle: a small map (poses within 1 m, range limits up to 3 m, tau = 0) integrated next to
+//    the dense cell-by-cell reference (test/core/dense_reference.h); every cell, every coarse
+//    scale up to 3, and clearBox (cleared cells back to the prior, the others unchanged) must
+//    agree with it;
+//  - hostile: any value anywhere; the contract is only "no crash, no undefined behaviour, bounded
+//    work, a consistent read-out and an exact save / load round trip".
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "dense_reference.h"
+#include "fuzz_support.h"
+#include "reference_oracle.h"
+#include "wavog_mapping/core/wavelet_map.h"
+
+namespace {
+
+using wavog::Aggregation;
+using wavog::CellBox;
+using wavog::MapParams;
+using wavog::Pose2;
+using wavog::Raster;
+using wavog::ScanView;
+using wavog::WaveletMap;
+using wavog_fuzz::hostileDouble;
+using wavog_fuzz::hostileRange;
+
+constexpr double kTwoPi = 6.283185307179586;
+constexpr std::size_t kMaxBeams = 720;
+constexpr int kMaxScans = 4;
+constexpr int kOracleMaxScale = 3;  // coarse scales compared with the reference
+
+struct Scan {
+  Pose2 pose;
+  std::vector<float> ranges;
+  double angle_min = 0, angle_increment = 0, range_min = 0, range_max = 0;
+  ScanView view() const {
+    return ScanView{ranges.data(), ranges.size(), angle_min, angle_increment, range_min, range_max};
+  }
+};
+
+using wavog_fuzz::Box;
+
+struct Case {
+  bool oracle = false;
+  MapParams params;
+  std::vector<Scan> scans;
+  Box clear;
+};
+
+double pick(FuzzedDataProvider* in, std::initializer_list<double> values) {
+  const auto i = in->ConsumeIntegralInRange<std::size_t>(0, values.size() - 1);
+  return *(values.begin() + static_cast<std::ptrdiff_t>(i));
+}
+
+MapParams decodeParams(FuzzedDataProvider* in, bool oracle) {
+  const auto type = static_cast<wavog::PolicyType>(in->ConsumeIntegralInRange<int>(0, 5));
+  MapParams p = MapParams::defaultsFor(type);
+  p.policy.init = in->ConsumeBool() ? wavog::InitValue::kEmptyBound : wavog::InitValue::kUnknown;
+  p.lazy_forgetting = in->ConsumeBool();
+  if (oracle) {
+    p.grid.resolution = pick(in, {0.05, 0.1, 0.2, 0.15});
+    p.grid.block_levels = in->ConsumeIntegralInRange<int>(2, 5);
+    if (in->ConsumeBool()) {
+      p.sensor.odd_occ = in->ConsumeFloatingPointInRange<double>(0.05, 6.0);
+      p.sensor.odd_emp = -in->ConsumeFloatingPointInRange<double>(0.05, 6.0);
+      p.policy.gamma = in->ConsumeFloatingPointInRange<double>(0.01, 1.0);
+      p.policy.clamp_min = -in->ConsumeFloatingPointInRange<double>(0.1, 5.0);
+      p.policy.clamp_max = in->ConsumeFloatingPointInRange<double>(0.1, 5.0);
+    }
+    p.sensor.band_width = in->ConsumeBool() ? 0.0 : in->ConsumeFloatingPointInRange<double>(0, 0.5);
+    p.sensor.max_range = in->ConsumeBool() ? 0.0 : in->ConsumeFloatingPointInRange<double>(0, 3.0);
+    p.sensor.no_return_clear =
+        in->ConsumeBool() ? 0.0 : in->ConsumeFloatingPointInRange<double>(0, 3.0);
+    return p;
+  }
+  // Each parameter is hostile with probability 1/4, else a valid value: a run of invalid ones
+  // would almost never reach the integration (the constructor refuses them, which is checked).
+  const auto maybe = [in](double valid, double lo, double hi) {
+    return in->ConsumeIntegralInRange<int>(0, 3) == 0 ? hostileDouble(in, lo, hi) : valid;
+  };
+  p.grid.resolution = maybe(pick(in, {0.01, 0.05, 0.1, 0.5, 2.0}), 0.001, 100.0);
+  p.grid.block_levels = in->ConsumeIntegralInRange<int>(1, 13);
+  p.sensor.odd_occ = maybe(p.sensor.odd_occ, 0.0, 10.0);
+  p.sensor.odd_emp = maybe(p.sensor.odd_emp, -10.0, 0.0);
+  p.sensor.band_width = maybe(p.sensor.band_width, 0.0, 2.0);
+  p.sensor.max_range = maybe(p.sensor.max_range, 0.0, 100.0);
+  p.sensor.no_return_clear = maybe(p.sensor.no_return_clear, 0.0, 100.0);
+  p.policy.gamma = maybe(p.policy.gamma, 0.0, 1.0);
+  p.policy.clamp_min = maybe(p.policy.clamp_min, -10.0, 0.0);
+  p.policy.clamp_max = maybe(p.policy.clamp_max, 0.0, 10.0);
+  p.prune_threshold = maybe(p.prune_threshold, 0.0, 1.0);
+  p.skip_tolerance = maybe(p.skip_tolerance, 0.0, 1.0);
+  return p;
+}
+
+Scan decodeScan(FuzzedDataProvider* in, bool oracle) {
+  Scan s;
+  const std::size_t n = in->ConsumeIntegralInRange<std::size_t>(oracle ? 1 : 0, kMaxBeams);
+  if (oracle) {
+    s.pose.x = in->ConsumeFloatingPointInRange<double>(-1.0, 1.0);
+    s.pose.y = in->ConsumeFloatingPointInRange<double>(-1.0, 1.0);
+    s.pose.theta = in->ConsumeFloatingPointInRange<double>(-7.0, 7.0);
+    s.angle_min = in->ConsumeFloatingPointInRange<double>(-7.0, 7.0);
+    const double fov = in->ConsumeFloatingPointInRange<double>(0.0, kTwoPi);
+    s.angle_increment = std::max(fov / static_cast<double>(n), 1e-9) * (in->ConsumeBool() ? 1 : -1);
+    s.range_min = in->ConsumeBool() ? 0.0 : in->ConsumeFloatingPointInRange<double>(0.0, 1.0);
+    s.range_max = in->ConsumeFloatingPointInRange<double>(0.1, 3.0);
+  } else {
+    s.pose.x = hostileDouble(in, -50.0, 50.0);
+    s.pose.y = hostileDouble(in, -50.0, 50.0);
+    s.pose.theta = hostileDouble(in, -7.0, 7.0);
+    s.angle_min = hostileDouble(in, -7.0, 7.0);
+    s.angle_increment = hostileDouble(in, -0.1, 0.1);
+    s.range_min = hostileDouble(in, 0.0, 1.0);
+    s.range_max = hostileDouble(in, 0.0, 100.0);
+  }
+  s.ranges.resize(n);
+  const auto hi = static_cast<float>(oracle ? 4.0 : 120.0);
+  for (auto& r : s.ranges) r = hostileRange(in, hi);
+  return s;
+}
+
+Case decode(const std::uint8_t* data, std::size_t size) {
+  FuzzedDataProvider in(data, size);
+  Case c;
+  c.oracle = in.ConsumeBool();
+  c.params = decodeParams(&in, c.oracle);
+  const int scans = in.ConsumeIntegralInRange<int>(1, kMaxScans);
+  for (int i = 0; i < scans; ++i) c.scans.push_back(decodeScan(&in, c.oracle));
+  const double lim = c.oracle ? 5.0 : 100.0;
+  if (c.oracle) {
+    c.clear = {in.ConsumeFloatingPointInRange<double>(-lim, lim),
+               in.ConsumeFloatingPointInRange<double>(-lim, lim),
+               in.ConsumeFloatingPointInRange<double>(-lim, lim),
+               in.ConsumeFloatingPointInRange<double>(-lim, lim)};
+  } else {
+    c.clear = {hostileDouble(&in, -lim, lim), hostileDouble(&in, -lim, lim),
+               hostileDouble(&in, -lim, lim), hostileDouble(&in, -lim, lim)};
+  }
+  return c;
+}
+
+bool sameBits(const Raster& a, const Raster& b) {
+  return a.scale == b.scale && a.box.min_x == b.box.min_x && a.box.min_y == b.box.min_y &&
+         a.box.max_x == b.box.max_x && a.box.max_y == b.box.max_y && a.known == b.known &&
+         a.log_odds.size() == b.log_odds.size() &&
+         std::memcmp(a.log_odds.data(), b.log_odds.data(), a.log_odds.size() * sizeof(float)) == 0;
+}
+
+std::vector<Raster> readOut(const WaveletMap& map) {
+  std::vector<Raster> out;
+  for (int s = 0; s <= map.params().grid.block_levels; ++s) {
+    CellBox box;
+    if (!map.bounds(s, &box)) break;
+    if (wavog_fuzz::readOutGuarded(box.width(), box.height())) continue;  // known finding
+    Raster r = map.exportScale(s, box, Aggregation::kMean);
+    const auto cells =
+        static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
+    WAVOG_FUZZ_CHECK(r.log_odds.size() == cells && r.known.size() == cells,
+                     "scale %d: %zu cells for a %lld x %lld window", s, r.log_odds.size(),
+                     static_cast<long long>(box.width()), static_cast<long long>(box.height()));
+    (void)wavog::toOccupancyGrid(r);
+    out.push_back(std::move(r));
+    out.push_back(map.exportScale(s, box, Aggregation::kMax));
+  }
+  return out;
+}
+
+void runOracle(const Case& c, WaveletMap* map) {
+  // Everything a scan can reach: poses within 1 m, range limits up to 3 m, half a band of 0.25 m.
+  const auto cells = static_cast<std::int64_t>(std::ceil(4.5 / c.params.grid.resolution)) + 2;
+  wavog_test::DenseReference ref(c.params, CellBox{-cells, -cells, cells, cells});
+  for (const auto& s : c.scans) {
+    map->integrate(s.pose, s.view());
+    ref.integrate(s.pose, s.view());
+  }
+  wavog_fuzz::expectCellsEqual(*map, ref, nullptr, "after the scans");
+  wavog_fuzz::expectScalesEqual(*map, ref, kOracleMaxScale);
+  map->clearBox(c.clear.min_x, c.clear.min_y, c.clear.max_x, c.clear.max_y);
+  wavog_fuzz::expectCellsEqual(*map, ref, &c.clear, "after clearBox");
+  // Nothing outside the reference's extent was written.
+  CellBox b;
+  if (map->bounds(0, &b)) {
+    const std::int64_t block = std::int64_t{1} << c.params.grid.block_levels;
+    WAVOG_FUZZ_CHECK(b.min_x >= -cells - block && b.max_x <= cells + block &&
+                         b.min_y >= -cells - block && b.max_y <= cells + block,
+                     "blocks beyond the scans' reach: [%lld, %lld) x [%lld, %lld)",
+                     static_cast<long long>(b.min_x), static_cast<long long>(b.max_x),
+                     static_cast<long long>(b.min_y), static_cast<long long>(b.max_y));
+  }
+}
+
+// ---- guards: input classes with known core findings (issue 16, second pass) ------------------
+// TODO(hostile, #16): remove each guard with the core fix it waits for; WAVOG_FUZZ_NO_GUARDS=1
+// lifts them to reproduce the findings.
+
+/// The scan's reach as the core computes it: the farthest band end of a hit (a reading below
+/// the effective range limit) or the no-return clearing distance (m).
+double reachOf(const MapParams& p, const Scan& s) {
+  const double sensor_max =
+      p.sensor.max_range > 0 ? std::min(p.sensor.max_range, s.range_max) : s.range_max;
+  const double half_band =
+      0.5 * (p.sensor.band_width > 0 ? p.sensor.band_width : p.grid.resolution);
+  double reach = 0;
+  for (float r : s.ranges) {
+    const double z = r;
+    if (std::isnan(z) || z <= 0 || z < s.range_min) continue;
+    reach = std::max(reach, z >= sensor_max ? p.sensor.no_return_clear : z + half_band);
+  }
+  return reach;
+}
+
+/// Why the core cannot take this scan today without a crash, UB or unbounded work; nullptr if
+/// it can.
+const char* knownScanFinding(const MapParams& p, const Scan& s) {
+  if (!wavog_fuzz::guardsOn()) return nullptr;
+  if (!std::isfinite(s.pose.x) || !std::isfinite(s.pose.y)) return nullptr;  // refused: kBadPose
+  const double res = p.grid.resolution;
+  const double reach = reachOf(p, s);
+  // Finding F3: a hit's cell index is a float-to-int64 cast of (pose + z (cos, sin)) / res with
+  // no range check (scan_integrator.cpp, prepare(): "inf is outside the range of representable
+  // values of type 'long'"); pose.y = 1.6e308 at 0.01 m reaches it.
+  constexpr double kCellLimit = 1099511627776.0;  // 2^40 cells
+  if ((std::fabs(s.pose.x) + reach) / res > kCellLimit ||
+      (std::fabs(s.pose.y) + reach) / res > kCellLimit) {
+    return "pose or reach beyond 2^40 cells";
+  }
+  // Finding F5: a finite but huge angle_min (1.1e308) turns the bearing arithmetic into inf - inf
+  // and the NaN reaches a float-to-long cast (scan_integrator.cpp, classifyBox's beamRange:
+  // "-nan is outside the range of representable values of type 'long'").
+  constexpr double kAngleLimit = 1e6;  // rad
+  if (!(std::fabs(s.angle_min) <= kAngleLimit)) return "angle_min beyond 1e6 rad";
+  // Finding H1 (issue 16, "hang"): the block loop covers (2 reach / block size)^2 blocks.
+  constexpr double kReachBlocks = 256.0;
+  if (reach / std::ldexp(res, p.grid.block_levels) > kReachBlocks) return "reach beyond 256 blocks";
+  return nullptr;
+}
+
+/// Finding F4: clearBox casts bound / resolution to int64 unchecked (wavelet_map.cpp, clearBox:
+/// "-inf is outside the range of representable values of type 'long'"); +-1e19 at 0.05 m does it.
+bool knownClearBoxFinding(const MapParams& p, const Box& b) {
+  if (!wavog_fuzz::guardsOn()) return false;
+  constexpr double kCellLimit = 4611686018427387904.0;  // 2^62 cells
+  for (double v : {b.min_x, b.min_y, b.max_x, b.max_y}) {
+    if (!(std::fabs(v) / p.grid.resolution < kCellLimit)) return !std::isnan(v);
+  }
+  return false;
+}
+
+// WAVOG_FUZZ_DESCRIBE=1: prints the decoded case (to turn a finding into a unit test).
+void describe(const Case& c) {
+  const MapParams& p = c.params;
+  std::fprintf(stderr,
+               "case: %s; resolution %.17g block_levels %d policy %s init %s lazy %d\n"
+               "  odd_occ %.17g odd_emp %.17g band_width %.17g max_range %.17g "
+               "no_return_clear %.17g\n  gamma %.17g clamp [%.17g, %.17g] prune %.17g skip %.17g\n",
+               c.oracle ? "oracle" : "hostile", p.grid.resolution, p.grid.block_levels,
+               wavog::toString(p.policy.type), wavog::toString(p.policy.init), p.lazy_forgetting,
+               p.sensor.odd_occ, p.sensor.odd_emp, p.sensor.band_width, p.sensor.max_range,
+               p.sensor.no_return_clear, p.policy.gamma, p.policy.clamp_min, p.policy.clamp_max,
+               p.prune_threshold, p.skip_tolerance);
+  for (const auto& s : c.scans) {
+    std::fprintf(stderr,
+                 "  scan: pose (%.17g, %.17g, %.17g) angle_min %.17g increment %.17g range "
+                 "[%.17g, %.17g] %zu beams:",
+                 s.pose.x, s.pose.y, s.pose.theta, s.angle_min, s.angle_increment, s.range_min,
+                 s.range_max, s.ranges.size());
+    for (float r : s.ranges) std::fprintf(stderr, " %.9g", static_cast<double>(r));
+    std::fprintf(stderr, "\n");
+  }
+  std::fprintf(stderr, "  clearBox [%.17g, %.17g] x [%.17g, %.17g]\n", c.clear.min_x, c.clear.max_x,
+               c.clear.min_y, c.clear.max_y);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const Case c = decode(data, size);
+  static const bool describe_cases = std::getenv("WAVOG_FUZZ_DESCRIBE") != nullptr;
+  if (describe_cases) describe(c);
+  if (!c.params.validate().empty()) {
+    bool threw = false;
+    try {
+      WaveletMap refused(c.params);
+    } catch (const std::invalid_argument&) {
+      threw = true;
+    }
+    WAVOG_FUZZ_CHECK(threw, "invalid parameters accepted");
+    return 0;
+  }
+  WaveletMap map(c.params);
+  if (c.oracle) {
+    runOracle(c, &map);
+  } else {
+    for (const auto& s : c.scans) {
+      if (knownScanFinding(c.params, s) != nullptr) continue;
+      const auto st = map.integrate(s.pose, s.view());
+      if (st.status == wavog::ScanStatus::kOk) {
+        WAVOG_FUZZ_CHECK(st.beams_hit + st.beams_no_return + st.beams_invalid == s.ranges.size(),
+                         "%u + %u + %u beams counted of %zu", st.beams_hit, st.beams_no_return,
+                         st.beams_invalid, s.ranges.size());
+      }
+    }
+    if (!knownClearBoxFinding(c.params, c.clear)) {
+      map.clearBox(c.clear.min_x, c.clear.min_y, c.clear.max_x, c.clear.max_y);
+    }
+  }
+
+  const auto rasters = readOut(map);
+  const auto st = map.stats(true);
+  WAVOG_FUZZ_CHECK(st.bytes <= st.bytes_reserved, "stats: %zu bytes > %zu reserved", st.bytes,
+                   st.bytes_reserved);
+  static const std::string path = wavog_fuzz::scratchPath("integrate.wavog");
+  map.save(path);
+  WaveletMap loaded(c.params);
+  loaded.load(path);
+  const auto again = readOut(loaded);
+  WAVOG_FUZZ_CHECK(rasters.size() == again.size(), "round trip: %zu vs %zu rasters", rasters.size(),
+                   again.size());
+  for (std::size_t i = 0; i < rasters.size(); ++i) {
+    WAVOG_FUZZ_CHECK(sameBits(rasters[i], again[i]), "round trip: raster %zu differs", i);
+  }
+  WAVOG_FUZZ_CHECK(loaded.stats(true).observed_cells == st.observed_cells,
+                   "round trip: %llu vs %llu observed cells",
+                   static_cast<unsigned long long>(loaded.stats(true).observed_cells),
+                   static_cast<unsigned long long>(st.observed_cells));
+  return 0;
+}
