@@ -34,6 +34,9 @@ function(wavog_tools_test name)
 endfunction()
 
 wavog_tools_test(test_image_io)
+# The PNG test decodes with Python's PIL (python3-pil), independent of libpng.
+find_package(Python3 COMPONENTS Interpreter REQUIRED)
+target_compile_definitions(test_image_io PRIVATE WAVOG_PYTHON="${Python3_EXECUTABLE}")
 wavog_tools_test(test_tool_support)
 
 if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_log2bag.cpp)
