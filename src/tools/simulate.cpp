@@ -7,12 +7,12 @@
 #include <ros/time.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/LaserScan.h>
-#include <sys/stat.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -28,8 +28,6 @@
 #include "wavog_mapping/sim/world_file.h"
 
 namespace {
-
-using wavog_tools::parseNumber;
 
 using wavog::sim::GridWindow;
 using wavog::sim::LaserParams;
@@ -55,64 +53,31 @@ struct Options {
   std::string write_world;  // write the world as YAML here
 };
 
-void usage(std::ostream& out) {
-  out << "usage: wavog_simulate [options]\n"
-         "Simulates a vehicle with planar lasers (default: the car park with four LMS-291) and\n"
-         "writes a rosbag: one LaserScan topic per laser, /tf (map -> base_link), /tf_static.\n\n"
-         "  --world FILE          YAML/JSON world (default: the built-in car park)\n"
-         "  --out BAG             output bag (default scenario.bag)\n"
-         "  --seed N              noise seed (default 1); same seed, same bag\n"
-         "  --duration S          simulated seconds (default: the world's, 60 for the car park)\n"
-         "  --noise SIGMA         range noise standard deviation (m) for every laser\n"
-         "  --dropout P           NaN dropout probability per beam for every laser\n"
-         "  --map-frame F         fixed frame of /tf (default map)\n"
-         "  --base-frame F        vehicle frame (default base_link)\n"
-         "  --truth-dir DIR       write ground truth there: world.yaml, truth_<t>s.png/.pgm/.yaml\n"
-         "  --truth-resolution R  ground-truth cell size (m, default 0.1)\n"
-         "  --truth-every S       ground-truth snapshot period (s, default 10)\n"
-         "  --write-world FILE    write the world as YAML (e.g. to edit the default) and go on\n";
+/// The command line of wavog_simulate (its --help is generated from these).
+void addOptions(CLI::App* app, Options* o) {
+  app->add_option("--world", o->world_file, "YAML/JSON world (default: the built-in car park)");
+  app->add_option("--out", o->bag, "output bag")->capture_default_str();
+  wavog_tools::addInteger(app, "--seed", &o->seed, 0, "noise seed; same seed, same bag");
+  wavog_tools::addNumber(app, "--duration", &o->duration,
+                         "simulated seconds (< 0: the world's, 60 for the car park)");
+  wavog_tools::addNumber(app, "--noise", &o->noise_sigma,
+                         "range noise standard deviation (m) for every laser (< 0: each laser's)");
+  wavog_tools::addNumber(app, "--dropout", &o->dropout,
+                         "NaN dropout probability per beam for every laser (< 0: each laser's)");
+  app->add_option("--map-frame", o->map_frame, "fixed frame of /tf")->capture_default_str();
+  app->add_option("--base-frame", o->base_frame, "vehicle frame")->capture_default_str();
+  app->add_option("--truth-dir", o->truth_dir,
+                  "write ground truth there: world.yaml, truth_<t>s.png/.pgm/.yaml");
+  wavog_tools::addNumber(app, "--truth-resolution", &o->truth_resolution,
+                         "ground-truth cell size (m)");
+  wavog_tools::addNumber(app, "--truth-every", &o->truth_every, "ground-truth snapshot period (s)");
+  app->add_option("--write-world", o->write_world,
+                  "write the world as YAML (e.g. to edit the default) and go on");
 }
 
-Options parseArgs(int argc, char** argv) {
-  Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      usage(std::cout);
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + a);
-    const char* v = argv[++i];
-    if (a == "--world")
-      o.world_file = v;
-    else if (a == "--out")
-      o.bag = v;
-    else if (a == "--seed")
-      o.seed = static_cast<std::uint64_t>(parseNumber(a, v));
-    else if (a == "--duration")
-      o.duration = parseNumber(a, v);
-    else if (a == "--noise")
-      o.noise_sigma = parseNumber(a, v);
-    else if (a == "--dropout")
-      o.dropout = parseNumber(a, v);
-    else if (a == "--map-frame")
-      o.map_frame = v;
-    else if (a == "--base-frame")
-      o.base_frame = v;
-    else if (a == "--truth-dir")
-      o.truth_dir = v;
-    else if (a == "--truth-resolution")
-      o.truth_resolution = parseNumber(a, v);
-    else if (a == "--truth-every")
-      o.truth_every = parseNumber(a, v);
-    else if (a == "--write-world")
-      o.write_world = v;
-    else
-      throw std::invalid_argument("unknown option: " + a);
-  }
+void validate(const Options& o) {
   if (!(o.truth_resolution > 0.0)) throw std::invalid_argument("--truth-resolution must be > 0");
   if (!(o.truth_every > 0.0)) throw std::invalid_argument("--truth-every must be > 0");
-  return o;
 }
 
 geometry_msgs::TransformStamped transformMsg(const std::string& parent, const std::string& child,
@@ -151,10 +116,9 @@ std::string absoluteTopic(const std::string& topic) {
 }
 
 void writeTruth(const World& world, const Options& o) {
-  if (mkdir(o.truth_dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw std::runtime_error(o.truth_dir + ": cannot create directory");
-  }
-  std::ofstream(o.truth_dir + "/world.yaml") << wavog::sim::worldToYaml(world);
+  std::filesystem::create_directories(o.truth_dir);
+  std::ofstream(std::filesystem::path(o.truth_dir) / "world.yaml")
+      << wavog::sim::worldToYaml(world);
   const GridWindow window =
       GridWindow::covering(world.region_min, world.region_max, o.truth_resolution);
   for (int k = 0; k * o.truth_every < world.duration + 1e-9; ++k) {
@@ -169,14 +133,15 @@ void writeTruth(const World& world, const Options& o) {
     raster.known.assign(occ.size(), 1);
     for (std::size_t i = 0; i < occ.size(); ++i) raster.log_odds[i] = occ[i] ? 20.0f : -20.0f;
     std::ostringstream base;
-    base << o.truth_dir << "/truth_" << std::fixed << std::setprecision(1) << std::setw(6)
-         << std::setfill('0') << t << "s";
+    base << (std::filesystem::path(o.truth_dir) / "truth_").string() << std::fixed
+         << std::setprecision(1) << std::setw(6) << std::setfill('0') << t << "s";
     wavog::writePng(base.str() + ".png", wavog::renderGrey(raster));
     wavog::writeMapServerMap(base.str(), raster);
   }
 }
 
 int run(const Options& o) {
+  validate(o);
   World world =
       o.world_file.empty() ? wavog::sim::defaultWorld() : wavog::sim::loadWorld(o.world_file);
   if (o.duration > 0.0) world.duration = o.duration;
@@ -244,14 +209,9 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(parseArgs(argc, argv));
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "wavog_simulate: " << e.what() << "\n";
-    usage(std::cerr);
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "wavog_simulate: " << e.what() << "\n";
-    return 1;
-  }
+  return wavog_tools::toolMain(
+      argc, argv, "wavog_simulate",
+      "Simulates a vehicle with planar lasers (default: the car park with four LMS-291) and writes "
+      "a rosbag: one LaserScan topic per laser, /tf (map -> base_link), /tf_static.",
+      addOptions, run);
 }
