@@ -46,6 +46,12 @@ struct Options {
   std::string core_maps;              // also map with the default forgetting config, PNGs here
 };
 
+/// What --help says first.
+constexpr const char* kDescription =
+    "Runs a simulated scenario through every update policy and compares the maps with the "
+    "ground truth: report.md, summary.json and the figures' data in figure_data/ "
+    "(scripts/plot_evaluation.py draws policies.png, departure.png, arrival.png from it).";
+
 /// The command line of wavog_evaluate (its --help is generated from these).
 void addOptions(CLI::App* app, Options* o) {
   app->add_option("--world", o->world_file, "YAML/JSON world (default: the built-in car park)");
@@ -190,10 +196,5 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return wavog_tools::toolMain(
-      argc, argv, "wavog_evaluate",
-      "Runs a simulated scenario through every update policy and compares the maps with the "
-      "ground truth: report.md, summary.json and the figures' data in figure_data/ "
-      "(scripts/plot_evaluation.py draws policies.png, departure.png, arrival.png from it).",
-      addOptions, run);
+  return wavog_tools::toolMain(argc, argv, "wavog_evaluate", kDescription, addOptions, run);
 }

@@ -41,6 +41,11 @@ struct Options {
   bool quiet = false;
 };
 
+/// What --help says first.
+constexpr const char* kDescription =
+    "Converts a CARMEN log (FLASER, RLASER, ROBOTLASER1; plain or .gz) into a rosbag: "
+    "/front_laser/scan, /rear_laser/scan (sensor_msgs/LaserScan), /tf, /tf_static.";
+
 /// The command line of wavog_log2bag (its --help is generated from these).
 void addOptions(CLI::App* app, Options* o) {
   wavog_tools::addInteger(app, "--max-scans", &o->max_scans, 0,
@@ -287,9 +292,5 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return wavog_tools::toolMain(
-      argc, argv, "wavog_log2bag",
-      "Converts a CARMEN log (FLASER, RLASER, ROBOTLASER1; plain or .gz) into a rosbag: "
-      "/front_laser/scan, /rear_laser/scan (sensor_msgs/LaserScan), /tf, /tf_static.",
-      addOptions, run);
+  return wavog_tools::toolMain(argc, argv, "wavog_log2bag", kDescription, addOptions, run);
 }

@@ -74,6 +74,12 @@ std::vector<int> parseScales(const std::string& text) {
   return scales;
 }
 
+/// What --help says first.
+constexpr const char* kDescription =
+    "Maps INPUT, a rosbag (LaserScan + /tf, /tf_static) or a CARMEN log (plain or .gz), without "
+    "a roscore, and writes to the output folder: map_s<scale>.png (unknown in pale blue), "
+    "map_s<scale>.pgm + .yaml (map_server), map.wavog (native map), summary.json.";
+
 /// The command line of wavog_offline (its --help is generated from these).
 void addOptions(CLI::App* app, Options* o) {
   app->add_option("-o,--out", o->out, "output folder (created)")->capture_default_str();
@@ -668,11 +674,5 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return wavog_tools::toolMain(
-      argc, argv, "wavog_offline",
-      "Maps INPUT, a rosbag (LaserScan + /tf, /tf_static) or a CARMEN log (plain or .gz), without "
-      "a "
-      "roscore, and writes to the output folder: map_s<scale>.png (unknown in pale blue), "
-      "map_s<scale>.pgm + .yaml (map_server), map.wavog (native map), summary.json.",
-      addOptions, run);
+  return wavog_tools::toolMain(argc, argv, "wavog_offline", kDescription, addOptions, run);
 }

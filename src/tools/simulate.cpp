@@ -53,6 +53,11 @@ struct Options {
   std::string write_world;  // write the world as YAML here
 };
 
+/// What --help says first.
+constexpr const char* kDescription =
+    "Simulates a vehicle with planar lasers (default: the car park with four LMS-291) and writes "
+    "a rosbag: one LaserScan topic per laser, /tf (map -> base_link), /tf_static.";
+
 /// The command line of wavog_simulate (its --help is generated from these).
 void addOptions(CLI::App* app, Options* o) {
   app->add_option("--world", o->world_file, "YAML/JSON world (default: the built-in car park)");
@@ -209,9 +214,5 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return wavog_tools::toolMain(
-      argc, argv, "wavog_simulate",
-      "Simulates a vehicle with planar lasers (default: the car park with four LMS-291) and writes "
-      "a rosbag: one LaserScan topic per laser, /tf (map -> base_link), /tf_static.",
-      addOptions, run);
+  return wavog_tools::toolMain(argc, argv, "wavog_simulate", kDescription, addOptions, run);
 }

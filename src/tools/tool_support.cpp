@@ -244,6 +244,25 @@ long parseInteger(const std::string& flag, const char* text, long min_value) {
   return v;
 }
 
+std::string wrapText(const std::string& text, std::size_t width) {
+  std::istringstream words(text);
+  std::string word;
+  std::string out;
+  std::size_t line = 0;
+  while (words >> word) {
+    if (line > 0 && line + 1 + word.size() > width) {
+      out += "\n";
+      line = 0;
+    } else if (line > 0) {
+      out += " ";
+      ++line;
+    }
+    out += word;
+    line += word.size();
+  }
+  return out;
+}
+
 std::string longName(const std::string& names) {
   const std::size_t comma = names.find_last_of(',');
   return comma == std::string::npos ? names : names.substr(comma + 1);

@@ -156,11 +156,17 @@ CLI::Option* addInteger(CLI::App* app, const std::string& names, T* value, long 
       ->default_str(std::to_string(*value));
 }
 
+/// Width of the tools' --help descriptions.
+constexpr std::size_t kHelpWidth = 96;
+
 /// The main() of every tool: parses the command line with `app` (--help: the generated help on
 /// stdout, status 0; a usage error: "<name>: error: <what>" and the help on stderr, status 2),
 /// then returns `run`'s status; any exception (a bad number included) prints
 /// "<name>: error: <what>" and gives status 1.
 int runTool(CLI::App* app, int argc, char** argv, const std::function<int()>& run);
+
+/// `text` broken at spaces into lines of at most `width` characters (longer words stay whole).
+std::string wrapText(const std::string& text, std::size_t width);
 
 /// A whole main(): `add_options` declares the options of a default `Options` on an app called
 /// `name` (its --help shows `description`), then runTool with `run`.
@@ -168,7 +174,7 @@ template <typename Options>
 int toolMain(int argc, char** argv, const char* name, const char* description,
              void (*add_options)(CLI::App*, Options*), int (*run)(const Options&)) {
   Options options;
-  CLI::App app{description, name};
+  CLI::App app{wrapText(description, kHelpWidth), name};
   add_options(&app, &options);
   return runTool(&app, argc, argv, [&] { return run(options); });
 }

@@ -111,6 +111,11 @@ TEST(TextHelpers, Lists) {
   EXPECT_EQ(wavog_tools::stripSlash("laser"), "laser");
 }
 
+TEST(TextHelpers, WrapText) {
+  EXPECT_EQ(wavog_tools::wrapText("aa bb  cc dddddd e", 5), "aa bb\ncc\ndddddd\ne");
+  EXPECT_EQ(wavog_tools::wrapText("", 5), "");
+}
+
 TEST(TextHelpers, StrictNumbers) {
   EXPECT_DOUBLE_EQ(wavog_tools::parseNumber("--rate", "0.25"), 0.25);
   EXPECT_DOUBLE_EQ(wavog_tools::parseNumber("--epoch", "-3e2"), -300.0);

@@ -45,9 +45,11 @@ int main(int argc, char** argv) {
   wavog_compare::Options opt;
   for (int i = 0; i < argc; ++i) opt.command += (i ? " " : "") + std::string(argv[i]);
   CLI::App app{
-      "Runs wavog_core (clamping and forgetting), OctoMap and the dense baseline grid side by side "
-      "on the same scans: speed, memory, map agreement; writes results.md, results.csv and the "
-      "disagreement PNGs to --out.",
+      wavog_tools::wrapText(
+          "Runs wavog_core (clamping and forgetting), OctoMap and the dense baseline grid side "
+          "by side on the same scans: speed, memory, map agreement; writes results.md, "
+          "results.csv and the disagreement PNGs to --out.",
+          wavog_tools::kHelpWidth),
       "wavog_compare"};
   wavog_compare::addOptions(&app, &opt);
   return wavog_tools::runTool(&app, argc, argv, [&] { return run(&opt); });
