@@ -17,7 +17,8 @@ import math
 import os
 import sys
 
-from figure_common import DPI, run  # sets matplotlib's display-less backend first
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+from figure_common import DPI, run  # noqa: E402; sets matplotlib's display-less backend first
 
 import matplotlib.image as mpimg  # noqa: E402
 import matplotlib.patches as mpatches  # noqa: E402
