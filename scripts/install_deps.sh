@@ -15,6 +15,7 @@ PKGS=(
   python3-catkin-pkg python3-genmsg python3-gencpp python3-genpy libyaml-cpp-dev
   nlohmann-json3-dev libcli11-dev python3-matplotlib python3-pil
   ros-message-generation ros-message-runtime
+  libcli11-dev nlohmann-json3-dev python3-matplotlib python3-numpy
 )
 
 missing=()

@@ -24,6 +24,7 @@
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/sim/evaluation.h"
 #include "wavog_mapping/sim/laser_sim.h"
+#include "wavog_mapping/sim/noise_study.h"
 #include "wavog_mapping/sim/world.h"
 #include "wavog_mapping/sim/world_file.h"
 
@@ -44,6 +45,7 @@ struct Options {
   int jobs = 2;                       // policies evaluated in parallel
   std::string offline_summary;        // JSON file embedded as "offline_map" in summary.json
   std::string core_maps;              // also map with the default forgetting config, PNGs here
+  std::string pose_noise = "0:0,2:0.2,5:0.5";  // noise study levels (cm:deg); "none": skip
 };
 
 /// What --help says first.
@@ -73,11 +75,17 @@ void addOptions(CLI::App* app, Options* o) {
                   "also map the scenario with the default parameters (forgetting, 5 cm) through "
                   "the core and write map_s<scale>.png/.pgm/.yaml for scales 0, 2, 3, 4 there "
                   "(when wavog_offline is missing)");
+  app->add_option("--pose-noise", o->pose_noise,
+                  "pose-error study of none, max, clamp, forget: a list of "
+                  "SIGMA_XY_CM:SIGMA_YAW_DEG levels ('none' skips it); appended to report.md, "
+                  "also noise.json")
+      ->capture_default_str();
 }
 
 void validate(const Options& o) {
   if (!(o.resolution > 0.0)) throw std::invalid_argument("--resolution must be > 0");
   if (!(o.fraction > 0.0 && o.fraction <= 1.0)) throw std::invalid_argument("--fraction in (0, 1]");
+  if (o.pose_noise != "none") parseNoiseLevels(o.pose_noise, o.seed);  // fails early when bad
 }
 
 // The scenario mapped with the compiled defaults (the forgetting policy of config/default.yaml),
@@ -124,6 +132,44 @@ void printHeadline(const std::vector<WorldEvent>& events,
     std::cout << std::setw(11) << fixed(r.precision, 3) << std::setw(10)
               << fixed(100 * r.wall_distance, 1) << std::setw(10)
               << fixed(r.bytes_per_observed_cell, 2) << fixed(r.mean_scan_us, 0) << "\n";
+  }
+  std::cout << std::right << std::flush;
+}
+
+// The pose-error study (noise_study.h) over the paper's four policies, appended to report.md.
+void runPoseNoiseStudy(const World& world, const std::vector<SimScan>& scans,
+                       const std::vector<WorldEvent>& events, const std::vector<PolicyRun>& runs,
+                       const std::vector<PolicyResult>& results, const EvaluationOptions& eo,
+                       const Options& o) {
+  const std::vector<NoiseLevel> levels = parseNoiseLevels(o.pose_noise, o.seed);
+  std::vector<PolicyRun> paper_runs;
+  std::vector<PolicyResult> exact;  // today's results of those runs, reused for level 0
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (runs[i].params.policy.init == wavog::InitValue::kUnknown &&
+        runs[i].params.policy.type != wavog::PolicyType::kClampLower) {
+      paper_runs.push_back(runs[i]);
+      exact.push_back(results[i]);
+    }
+  }
+  if (paper_runs.empty()) return;
+  std::cerr << "wavog_evaluate: pose-noise study, " << levels.size() << " levels x "
+            << paper_runs.size() << " policies...\n";
+  const std::vector<NoiseStudyRow> rows =
+      runNoiseStudy(world, scans, events, paper_runs, levels, eo, o.jobs, &exact);
+  std::ofstream(fs::path(o.out_dir) / "report.md", std::ios::app) << "\n"
+                                                                  << noiseStudyMarkdown(rows);
+  std::ofstream(fs::path(o.out_dir) / "noise.json") << noiseStudyJson(rows);
+  std::cout << "\n"
+            << std::left << std::setw(22) << "pose noise" << std::setw(26) << "policy"
+            << std::setw(11) << "precision" << std::setw(10) << "wall cm" << std::setw(13)
+            << "surface cm"
+            << "wall width (cells)\n";
+  for (const NoiseStudyRow& row : rows) {
+    std::cout << std::setw(22) << row.level << std::setw(26) << row.result.label << std::setw(11)
+              << fixed(row.result.precision, 3) << std::setw(10)
+              << fixed(100 * row.walls.wall_distance_m, 1) << std::setw(13)
+              << fixed(100 * row.walls.surface_distance_m, 1)
+              << fixed(row.walls.width.mean_cells, 2) << "\n";
   }
   std::cout << std::right << std::flush;
 }
@@ -190,6 +236,7 @@ int run(const Options& o) {
             << "  /usr/bin/python3 scripts/plot_evaluation.py " << o.out_dir << "\n";
   if (!o.core_maps.empty()) writeCoreMaps(world, scans, o.core_maps);
   printHeadline(events, results);
+  if (o.pose_noise != "none") runPoseNoiseStudy(world, scans, events, runs, results, eo, o);
   return 0;
 }
 

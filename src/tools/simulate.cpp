@@ -24,6 +24,7 @@
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/sim/ground_truth.h"
 #include "wavog_mapping/sim/laser_sim.h"
+#include "wavog_mapping/sim/pose_noise.h"
 #include "wavog_mapping/sim/world.h"
 #include "wavog_mapping/sim/world_file.h"
 
@@ -51,7 +52,48 @@ struct Options {
   double truth_resolution = 0.1;
   double truth_every = 10.0;
   std::string write_world;  // write the world as YAML here
+  // Error of the /tf poses (the lasers measure from the true pose).
+  wavog::sim::PoseNoiseParams pose_noise;  // its seed: poseNoise()
+  long pose_seed = -1;                     // < 0: --seed
 };
+
+/// The /tf pose error options (the lasers always measure from the true pose).
+void addPoseNoiseOptions(CLI::App* app, Options* o) {
+  wavog_tools::addNumber(app, "--pose-sigma-xy", &o->pose_noise.sigma_xy_m,
+                         "per-scan Gaussian error of the /tf position, x and y (m)");
+  app->add_option_function<std::string>(
+         "--pose-sigma-yaw-deg",
+         [o](const std::string& v) {
+           o->pose_noise.sigma_yaw_rad =
+               wavog_tools::parseNumber("--pose-sigma-yaw-deg", v.c_str()) * M_PI / 180.0;
+         },
+         "per-scan Gaussian error of the /tf heading (deg)")
+      ->type_name("NUM")
+      ->default_str("0");
+  wavog_tools::addNumber(app, "--pose-drift-x", &o->pose_noise.drift_x_m_per_s,
+                         "slow linear drift of the /tf position along x (m/s)");
+  wavog_tools::addNumber(app, "--pose-drift-y", &o->pose_noise.drift_y_m_per_s,
+                         "slow linear drift of the /tf position along y (m/s)");
+  app->add_option_function<std::string>(
+         "--pose-drift-yaw-deg",
+         [o](const std::string& v) {
+           o->pose_noise.drift_yaw_rad_per_s =
+               wavog_tools::parseNumber("--pose-drift-yaw-deg", v.c_str()) * M_PI / 180.0;
+         },
+         "slow linear drift of the /tf heading (deg/s)")
+      ->type_name("NUM")
+      ->default_str("0");
+  wavog_tools::addInteger(app, "--pose-seed", &o->pose_seed, 0,
+                          "seed of the pose errors (default: --seed)")
+      ->default_str("--seed");
+}
+
+/// The pose error of the /tf poses, its seed --pose-seed or else --seed.
+wavog::sim::PoseNoiseParams poseNoise(const Options& o) {
+  wavog::sim::PoseNoiseParams p = o.pose_noise;
+  p.seed = o.pose_seed >= 0 ? static_cast<std::uint64_t>(o.pose_seed) : o.seed;
+  return p;
+}
 
 /// What --help says first.
 constexpr const char* kDescription =
@@ -78,11 +120,13 @@ void addOptions(CLI::App* app, Options* o) {
   wavog_tools::addNumber(app, "--truth-every", &o->truth_every, "ground-truth snapshot period (s)");
   app->add_option("--write-world", o->write_world,
                   "write the world as YAML (e.g. to edit the default) and go on");
+  addPoseNoiseOptions(app, o);
 }
 
 void validate(const Options& o) {
   if (!(o.truth_resolution > 0.0)) throw std::invalid_argument("--truth-resolution must be > 0");
   if (!(o.truth_every > 0.0)) throw std::invalid_argument("--truth-every must be > 0");
+  for (const std::string& e : poseNoise(o).validate()) throw std::invalid_argument(e);
 }
 
 geometry_msgs::TransformStamped transformMsg(const std::string& parent, const std::string& child,
@@ -175,13 +219,15 @@ int run(const Options& o) {
   (*latched)["callerid"] = "/wavog_simulate";
   bag.write("/tf_static", t0, statics, latched);
 
+  const wavog::sim::PoseNoiseParams noise = poseNoise(o);
   std::vector<std::size_t> per_laser(world.vehicle.lasers.size(), 0);
   SimScan scan;
   std::size_t done = 0;
   while (sim.next(&scan)) {
     const ros::Time stamp = t0 + ros::Duration(scan.stamp);
     tf2_msgs::TFMessage tf;
-    tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame, scan.vehicle_pose, stamp));
+    const wavog::Pose2 told = wavog::sim::withPoseError(world, scan, noise).vehicle_pose;
+    tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame, told, stamp));
     bag.write("/tf", stamp, tf);
     const LaserParams& laser = world.vehicle.lasers[static_cast<std::size_t>(scan.laser)];
     bag.write(absoluteTopic(laser.topic), stamp, scanMsg(scan, laser, stamp));
