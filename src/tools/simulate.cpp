@@ -57,32 +57,32 @@ struct Options {
   long pose_seed = -1;                     // < 0: --seed
 };
 
+/// An angle option given in degrees, kept in radians (read whole, as addNumber).
+void addDegrees(CLI::App* app, const std::string& name, double* radians, const std::string& help) {
+  std::ostringstream shown;
+  shown << *radians * 180.0 / M_PI;
+  app->add_option_function<std::string>(
+         name,
+         [name, radians](const std::string& v) {
+           *radians = wavog_tools::parseNumber(name, v.c_str()) * M_PI / 180.0;
+         },
+         help)
+      ->type_name("NUM")
+      ->default_str(shown.str());
+}
+
 /// The /tf pose error options (the lasers always measure from the true pose).
 void addPoseNoiseOptions(CLI::App* app, Options* o) {
   wavog_tools::addNumber(app, "--pose-sigma-xy", &o->pose_noise.sigma_xy_m,
                          "per-scan Gaussian error of the /tf position, x and y (m)");
-  app->add_option_function<std::string>(
-         "--pose-sigma-yaw-deg",
-         [o](const std::string& v) {
-           o->pose_noise.sigma_yaw_rad =
-               wavog_tools::parseNumber("--pose-sigma-yaw-deg", v.c_str()) * M_PI / 180.0;
-         },
-         "per-scan Gaussian error of the /tf heading (deg)")
-      ->type_name("NUM")
-      ->default_str("0");
+  addDegrees(app, "--pose-sigma-yaw-deg", &o->pose_noise.sigma_yaw_rad,
+             "per-scan Gaussian error of the /tf heading (deg)");
   wavog_tools::addNumber(app, "--pose-drift-x", &o->pose_noise.drift_x_m_per_s,
                          "slow linear drift of the /tf position along x (m/s)");
   wavog_tools::addNumber(app, "--pose-drift-y", &o->pose_noise.drift_y_m_per_s,
                          "slow linear drift of the /tf position along y (m/s)");
-  app->add_option_function<std::string>(
-         "--pose-drift-yaw-deg",
-         [o](const std::string& v) {
-           o->pose_noise.drift_yaw_rad_per_s =
-               wavog_tools::parseNumber("--pose-drift-yaw-deg", v.c_str()) * M_PI / 180.0;
-         },
-         "slow linear drift of the /tf heading (deg/s)")
-      ->type_name("NUM")
-      ->default_str("0");
+  addDegrees(app, "--pose-drift-yaw-deg", &o->pose_noise.drift_yaw_rad_per_s,
+             "slow linear drift of the /tf heading (deg/s)");
   wavog_tools::addInteger(app, "--pose-seed", &o->pose_seed, 0,
                           "seed of the pose errors (default: --seed)")
       ->default_str("--seed");
