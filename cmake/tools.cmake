@@ -34,6 +34,9 @@ function(wavog_tools_test name)
 endfunction()
 
 wavog_tools_test(test_image_io)
+# The PNG test decodes with Python's PIL (python3-pil), independent of libpng.
+find_package(Python3 COMPONENTS Interpreter REQUIRED)
+target_compile_definitions(test_image_io PRIVATE WAVOG_PYTHON="${Python3_EXECUTABLE}")
 wavog_tools_test(test_tool_support)
 
 if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_log2bag.cpp)
@@ -95,7 +98,7 @@ endif()
 find_package(CLI11 CONFIG REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 add_executable(wavog_paper src/tools/paper.cpp)
-target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io CLI11::CLI11
+target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io wavog_tool_support CLI11::CLI11
                       nlohmann_json::nlohmann_json Threads::Threads)
 target_compile_options(wavog_paper PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_paper PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})

@@ -14,6 +14,7 @@ PKGS=(
   librosbag-dev librosbag-storage-dev python3-rosbag python3-rostest python3-roslaunch
   python3-rosmaster python3-rostopic python3-rosnode python3-tf2-ros python3-rosgraph rosout
   python3-catkin-pkg python3-genmsg python3-gencpp python3-genpy libyaml-cpp-dev
+  nlohmann-json3-dev libcli11-dev python3-matplotlib python3-pil
   ros-message-generation ros-message-runtime
   libcli11-dev nlohmann-json3-dev python3-matplotlib python3-numpy
 )
