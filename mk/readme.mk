@@ -5,4 +5,4 @@
 .PHONY: readme-check
 readme-check: build
 	@[ -e $(ROOT)/demo_output/scenario.bag ] || $(MAKE) --no-print-directory demo
-	@bash $(ROOT)/scripts/check_readme_commands.sh
+	@timeout 1200 bash $(ROOT)/scripts/check_readme_commands.sh

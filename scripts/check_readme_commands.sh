@@ -15,7 +15,7 @@
 # ROS uses a master on a free port.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-readme=$root/README.md
+readme=${README_CHECK_FILE:-$root/README.md}   # another file: to test this checker
 wait_s=${README_CHECK_WAIT:-12}
 for need in "$root/build/devel/setup.bash" "$root/demo_output/scenario.bag"; do
   [ -e "$need" ] || { echo "readme-check: $need missing: run make test and make demo first" >&2; exit 1; }
@@ -62,7 +62,7 @@ while i < len(lines):
         parts.append(f"readme_background {shlex.quote(where)} {shlex.quote(body)}")
     elif mode == "run":
         n_run += 1
-        parts.append(f"readme_banner {shlex.quote(where)}\n{body}\nreadme_ok {shlex.quote(where)}")
+        parts.append(f"readme_banner {shlex.quote(where)}\nreadme_capture\n{body}\nreadme_ok {shlex.quote(where)}")
     else:
         sys.exit(f"README.md:{i + 1}: unknown check mode '{mode}'")
     i = k + 1
@@ -79,8 +79,25 @@ env -i HOME="$work" PATH=/usr/bin:/bin TERM=dumb ROS_HOME="$work/ros_home" \
 set -eo pipefail
 set -m   # background blocks get their own process group, and SIGINT reaches them
 bg_pids=()
-readme_banner() { echo; echo "readme-check: ---- $1"; }
-readme_ok() { echo "readme-check: $1: ok"; }
+readme_banner() { echo; echo "readme-check: ---- $1"; current=$1; }
+# A block runs in this shell (its cd, source and variables stay) with its output in a file, shown
+# afterwards; a service answering "success: False" fails it like a non-zero exit.
+readme_capture() { exec 4>&1 5>&2 >"$HOME/block.log" 2>&1; capturing=1; }
+readme_ok() {
+  exec 1>&4 2>&5; capturing=
+  cat "$HOME/block.log"
+  if grep -q "^success: False" "$HOME/block.log"; then echo "readme-check: $1: a service failed"; exit 1; fi
+  echo "readme-check: $1: ok"
+  current=
+}
+on_exit() {
+  status=$?
+  if [ "$status" -ne 0 ] && [ -n "${current:-}" ]; then
+    if [ -n "${capturing:-}" ]; then exec 1>&4 2>&5; cat "$HOME/block.log"; fi
+    echo "readme-check: $current: failed (status $status)"
+  fi
+  readme_stop
+}
 readme_background() {
   readme_banner "$1 (background)"
   bash -c "set +u; $2" >"$HOME/bg_$$_${#bg_pids[@]}.log" 2>&1 &
@@ -91,13 +108,14 @@ readme_background() {
     cat "$HOME/bg_$$_$((${#bg_pids[@]} - 1)).log"; echo "readme-check: $1: ended early"; exit 1
   fi
   echo "readme-check: $1: running after $WAIT_S s"
+  current=
 }
 readme_stop() {
   for p in "${bg_pids[@]}"; do kill -INT -- "-$p" 2>/dev/null || true; done
   for p in "${bg_pids[@]}"; do wait "$p" 2>/dev/null || true; done
   bg_pids=()
 }
-trap readme_stop EXIT
+trap on_exit EXIT
 source "'"$script"'"
 ' && status=0 || status=$?
 if [ "$status" -eq 0 ]; then
