@@ -10,9 +10,10 @@
 #   <!-- check: file NAME -->  the block's text is written to NAME (a config file shown in full)
 #   <!-- check: skip REASON --> not run here; the reason (what covers it instead) is printed
 # Every other code block (output samples, file formats, the set-up commands) is not a command to
-# check. The blocks run in one bash session, in order, in a scratch directory that mirrors the
-# repository (symlinks) beside a link to ../shared, so outputs do not land in the working tree;
-# ROS uses a master on a free port.
+# check. The blocks run in one bash session, in order, in the repository itself (as a user runs
+# them: a mirror made of symlinks would hide path effects, e.g. rosrun ignoring <package>/build/);
+# what they create there (files and folders git did not list before) is removed afterwards. HOME
+# and ROS_HOME are a scratch directory, and ROS uses a master on a free port.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 readme=${README_CHECK_FILE:-$root/README.md}   # another file: to test this checker
@@ -22,9 +23,11 @@ for need in "$root/build/devel/setup.bash" "$root/demo_output/scenario.bag"; do
 done
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/wavog_readme_check.XXXXXX")
-mkdir -p "$work/repo"
-for entry in "$root"/* "$root"/.ci; do ln -s "$entry" "$work/repo/$(basename "$entry")"; done
-ln -s "$(cd "$root/.." && pwd)/shared" "$work/shared"
+untracked() { git -C "$root" status --porcelain --ignored | sed -n 's/^\(??\|!!\) //p' | sort; }
+untracked >"$work/before.txt"
+remove_outputs() {
+  untracked | comm -13 "$work/before.txt" - | while read -r path; do rm -rf "${root:?}/$path"; done
+}
 script=$work/commands.sh
 
 # The README's blocks become one script: each block in a function-free section with a banner.
@@ -72,7 +75,7 @@ print(f"readme-check: {n_run} blocks to run, {n_bg} in the background, {n_skip} 
 PY
 
 port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')
-cd "$work/repo"
+cd "$root"
 env -i HOME="$work" PATH=/usr/bin:/bin TERM=dumb ROS_HOME="$work/ros_home" \
   ROS_MASTER_URI="http://localhost:$port" ROS_HOSTNAME=localhost WAIT_S="$wait_s" \
   bash -c '
@@ -118,6 +121,7 @@ readme_stop() {
 trap on_exit EXIT
 source "'"$script"'"
 ' && status=0 || status=$?
+remove_outputs
 if [ "$status" -eq 0 ]; then
   echo "readme-check: every checked README command worked"
   rm -rf "$work"

@@ -8,7 +8,7 @@ out=${1:?usage: rviz_screenshot.sh OUT.png}
 mkdir -p "$(dirname "$out")"
 display=:97
 export WAVOG_RVIZ_BAG="${out%.png}_scenario.bag"
-rosrun wavog_mapping wavog_simulate --duration 40 --out "$WAVOG_RVIZ_BAG" >/dev/null
+"$(catkin_find --first-only --libexec wavog_mapping wavog_simulate)" --duration 40 --out "$WAVOG_RVIZ_BAG" >/dev/null
 Xvfb $display -screen 0 1280x800x24 -nolisten tcp >/dev/null 2>&1 &
 xvfb_pid=$!
 export DISPLAY=$display LIBGL_ALWAYS_SOFTWARE=1
