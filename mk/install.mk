@@ -3,8 +3,9 @@
 # then test/install/install_test.sh on its install space (files, the core API, mapping.launch,
 # mapping_node.launch and fixed_frame_laser from the install space alone). A whole second build:
 # not part of `make test` (whose ctest entry install_space tests `cmake --install` of build/).
-# About 10 minutes on 2 cores without ccache.
-INSTALL_CHECK_WS ?= $(ROOT)/build-install-check
+# About 10 minutes on 2 cores without ccache. The workspace lies outside the repository: inside,
+# the link under src/ would make a loop that roslaunch's file search follows.
+INSTALL_CHECK_WS ?= $(or $(TMPDIR),/tmp)/wavog_install_check
 
 .PHONY: install-check
 install-check: deps

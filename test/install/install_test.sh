@@ -92,6 +92,18 @@ found=$(ros_env "rospack find wavog_mapping")
 ros_env "rospack plugins --attrib=plugin nodelet" | grep -q "$pkg/nodelet_plugins.xml" ||
   fail "the nodelet plugin is not registered from $pkg"
 
+# A key the config file sets is not overridden by a launch default; an argument given overrides it.
+printf 'map_frame: odom\ninputs: [scan]\n' >"$work/odom.yaml"
+for launch in mapping.launch mapping_node.launch playback.launch; do
+  dumped=$(ros_env "roslaunch --dump-params wavog_mapping $launch config:=$work/odom.yaml bag:=/none")
+  echo "$dumped" | grep -q "^/wavog_mapping/map_frame: odom$" ||
+    { echo "$dumped"; fail "$launch overrides the config's map_frame"; }
+  dumped=$(ros_env "roslaunch --dump-params wavog_mapping $launch config:=$work/odom.yaml bag:=/none map_frame:=world")
+  echo "$dumped" | grep -q "^/wavog_mapping/map_frame: world$" ||
+    { echo "$dumped"; fail "$launch: map_frame:=world not applied"; }
+done
+echo "install_test: map_frame: the config's value holds unless given as an argument"
+
 ros_env "rosrun wavog_mapping wavog_simulate --duration 4 --out '$work/scenario.bag'" >"$work/simulate.log" 2>&1 ||
   { cat "$work/simulate.log"; fail "wavog_simulate"; }
 
@@ -103,6 +115,7 @@ ros_env "rosparam list" >/dev/null 2>&1 || { cat "$work/roscore.log"; fail "rosc
 # run_case NAME LAUNCH_ARGS PLAY_ARGS: roslaunch, play the bag, wait for a map, stop.
 run_case() {
   local name=$1 launch=$2 play=$3 log=$work/$1.log
+  ros_env "rosparam set /wavog_mapping/stale_from_last_run 1"
   ros_env "exec roslaunch wavog_mapping $launch" >"$log" 2>&1 &
   local launch_pid=$!
   pids+=($launch_pid)
@@ -113,6 +126,9 @@ run_case() {
     cat "$log" "$log.wait"; fail "$name: no /map with occupied and free cells"
   fi
   kill -0 "$launch_pid" 2>/dev/null || { cat "$log"; fail "$name: roslaunch ended early"; }
+  if ros_env "rosparam get /wavog_mapping/stale_from_last_run" >/dev/null 2>&1; then
+    fail "$name: an old private parameter of the mapper survived the start (clear_params)"
+  fi
   kill -INT -- "-$launch_pid"; wait "$launch_pid" 2>/dev/null || true
   grep -h 'wait_for_map' "$log.wait"
   echo "install_test: $name: ok"
