@@ -8,7 +8,7 @@ target_link_libraries(wavog_test_support PUBLIC wavog_core wavog_io GTest::GTest
 target_include_directories(wavog_test_support PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/test/core)
 target_compile_options(wavog_test_support PRIVATE ${WAVOG_WARNINGS})
 target_compile_definitions(wavog_test_support PUBLIC
-  WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}" EIGEN_INITIALIZE_MATRICES_BY_NAN)
+  WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 
 # `core_tests` builds every core test (make test-asan builds only these).
 add_custom_target(core_tests)
@@ -30,3 +30,6 @@ wavog_core_test(test_readout)
 wavog_core_test(test_map_io)
 wavog_core_test(test_carmen_reader)
 wavog_core_test(test_motion_compensation)
+wavog_core_test(test_scan_classifier)
+wavog_core_test(test_integrate_stats)
+wavog_core_test(test_defaults)

@@ -9,9 +9,20 @@ target_link_libraries(wavog_ros_config PUBLIC wavog_core ${catkin_LIBRARIES} PRI
 target_compile_options(wavog_ros_config PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_ros_config PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
-# ---- wavog_ros: the mapper class (inputs, tf, publication, services, diagnostics) ------------
+# ---- wavog_ros: the mapper class (inputs, tf, publication, services, diagnostics) and the scan
+# placement it shares with wavog_offline ---------------------------------------------------------
 if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/mapping_ros.cpp)
-  add_library(wavog_ros src/ros/mapping_ros.cpp src/ros/conversions.cpp)
+  add_library(wavog_ros
+    src/ros/conversions.cpp
+    src/ros/scan_placement.cpp
+    src/ros/input_status.cpp
+    src/ros/map_publisher.cpp
+    src/ros/reconfigure.cpp
+    src/ros/mapping_ros.cpp
+    src/ros/mapping_ros_scans.cpp
+    src/ros/mapping_ros_publish.cpp
+    src/ros/mapping_ros_diagnostics.cpp
+    src/ros/mapping_ros_services.cpp)
   target_include_directories(wavog_ros SYSTEM PUBLIC ${WAVOG_ROS_INCLUDES})
   target_link_libraries(wavog_ros PUBLIC wavog_ros_config wavog_io wavog_core ${catkin_LIBRARIES})
   target_compile_options(wavog_ros PRIVATE ${WAVOG_WARNINGS})
@@ -34,6 +45,13 @@ if(CATKIN_ENABLE_TESTING)
   if(TARGET test_ros_config)
     target_link_libraries(test_ros_config wavog_ros_config ${GTEST_MAIN_LIBRARIES})
     target_compile_definitions(test_ros_config PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  endif()
+  # Scan placement (tf -> pose and view) and the dynamic_reconfigure mapping: no master needed.
+  if(TARGET wavog_ros)
+    catkin_add_gtest(test_scan_placement test/ros/test_scan_placement.cpp)
+    if(TARGET test_scan_placement)
+      target_link_libraries(test_scan_placement wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
   endif()
   if(TARGET wavog_mapping_node)
     find_package(rostest REQUIRED)

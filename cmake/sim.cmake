@@ -6,8 +6,9 @@ find_package(GTest REQUIRED)
 # Static: the installed tools then need no extra shared library.
 add_library(wavog_sim STATIC
   src/sim/geometry.cpp src/sim/world.cpp src/sim/world_file.cpp src/sim/laser_sim.cpp
-  src/sim/ground_truth.cpp)
+  src/sim/ground_truth.cpp src/sim/pose_noise.cpp src/sim/wall_metrics.cpp)
 target_link_libraries(wavog_sim PUBLIC wavog_core PRIVATE yaml-cpp)
+target_include_directories(wavog_sim SYSTEM PUBLIC ${EIGEN3_INCLUDE_DIR})
 target_compile_options(wavog_sim PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_sim PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
@@ -22,12 +23,16 @@ function(wavog_sim_test name)
 endfunction()
 
 # Policy evaluation through the core map (links wavog_core for real).
-add_library(wavog_sim_eval STATIC src/sim/evaluation.cpp)
-target_link_libraries(wavog_sim_eval PUBLIC wavog_sim wavog_core)
+add_library(wavog_sim_eval STATIC src/sim/evaluation.cpp src/sim/noise_study.cpp)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(Threads REQUIRED)
+target_link_libraries(wavog_sim_eval PUBLIC wavog_sim wavog_core
+                      PRIVATE nlohmann_json::nlohmann_json Threads::Threads)
 target_compile_options(wavog_sim_eval PRIVATE ${WAVOG_WARNINGS})
 
 wavog_sim_test(test_simulator wavog_sim)
 wavog_sim_test(test_policy_response wavog_sim_eval)
+wavog_sim_test(test_pose_noise wavog_sim_eval)
 
 # ---- wavog_simulate: scenario -> rosbag (rosbag C++ API, no roscore) --------------------------
 set(WAVOG_SIM_BIN_DIR ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})

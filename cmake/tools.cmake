@@ -45,7 +45,7 @@ endif()
 if(TARGET wavog_offline AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_offline.cpp)
   wavog_tools_test(test_offline)
   target_include_directories(test_offline SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
-  target_link_libraries(test_offline PRIVATE wavog_ros_config ${catkin_LIBRARIES})
+  target_link_libraries(test_offline PRIVATE wavog_ros ${catkin_LIBRARIES})
   target_compile_definitions(test_offline PRIVATE
     WAVOG_LOG2BAG="$<TARGET_FILE:wavog_log2bag>" WAVOG_OFFLINE="$<TARGET_FILE:wavog_offline>")
   add_dependencies(test_offline wavog_log2bag wavog_offline)
@@ -88,3 +88,13 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
                    "playback rostest not registered (set WAVOG_DATA_DIR)")
   endif()
 endif()
+
+# ---- wavog_paper (issue 17): the paper's figures from fr079 (make paper; no ROS at run time) ---
+find_package(CLI11 CONFIG REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+add_executable(wavog_paper src/tools/paper.cpp)
+target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io CLI11::CLI11
+                      nlohmann_json::nlohmann_json Threads::Threads)
+target_compile_options(wavog_paper PRIVATE ${WAVOG_WARNINGS})
+set_target_properties(wavog_paper PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
+install(TARGETS wavog_paper RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -14,6 +14,7 @@ PKGS=(
   python3-rosmaster python3-rostopic python3-rosnode python3-tf2-ros python3-rosgraph rosout
   python3-catkin-pkg python3-genmsg python3-gencpp python3-genpy libyaml-cpp-dev
   ros-message-generation ros-message-runtime
+  libcli11-dev nlohmann-json3-dev python3-matplotlib python3-numpy
   # What the README's commands use at run time: rosrun, rostopic / rosservice / dynparam on the
   # mapper's topics (Python message modules), the install-space test's map check.
   rosbash python3-rospy python3-rosservice python3-rosparam python3-nav-msgs python3-sensor-msgs

@@ -1,140 +1,24 @@
-// Private storage of WaveletMap: node pool, blocks, lazy-forgetting tags, and the shared
-// slot logic (create / prune a child node) used by integration, region clearing and loading.
-// Not installed; included only by src/core/*.cpp.
+// WaveletMap::Impl, what a WaveletMap holds: its parameters and their derived constants, the node
+// pool and the block hash, and the node operations every part of the map shares (create / free a
+// child node, lazy forgetting tags). Storage: node_pool.h, block_hash.h; slots: map_slot.h.
+// Not installed; included only by src/core/* and the core tests.
 #ifndef WAVOG_MAPPING_SRC_CORE_MAP_IMPL_H_
 #define WAVOG_MAPPING_SRC_CORE_MAP_IMPL_H_
 
 #include <array>
-#include <cmath>
 #include <cstdint>
-#include <memory>
-#include <unordered_map>
-#include <vector>
 
+#include "block_hash.h"
+#include "node_pool.h"
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
 namespace detail {
 
-/// One quadtree node at level l >= 1: the three Haar details of its 2x2 children, its children
-/// (a group of 4 node slots in the pool; a missing child is a uniform block), the lazy forgetting
-/// count and what is known of its children. Level-1 nodes have finest cells as children.
-struct Node {
-  float d[3] = {0.f, 0.f, 0.f};  ///< stored details dx, dy, dxy (true = stored * a^(pending k's))
-  std::uint32_t children = 0;    ///< pool group of the 4 child slots; 0 = no child node
-  std::uint8_t k = 0;            ///< pending forgetting steps for this node and its subtree
-  std::uint8_t child_mask = 0;   ///< bit q: child node q exists in the group
-  std::uint8_t known_all = 0;    ///< bit q: every finest cell of child q was observed
-  std::uint8_t known_any = 0;    ///< bit q: some finest cell of child q was observed
-};
-static_assert(sizeof(Node) == 20, "Node layout grew");
-
-struct NodeGroup {
-  Node n[4];
-};
-
-/// Pool of node groups in fixed chunks: group addresses never move, index 0 is reserved (null).
-class NodePool {
- public:
-  NodePool() { clear(); }
-  void clear() {
-    chunks_.clear();
-    free_.clear();
-    next_ = 1;
-    live_ = 0;
-    addChunk();
-  }
-  std::uint32_t allocate() {
-    std::uint32_t g;
-    if (!free_.empty()) {
-      g = free_.back();
-      free_.pop_back();
-    } else {
-      if ((next_ >> kChunkBits) >= chunks_.size()) addChunk();
-      g = next_++;
-    }
-    group(g) = NodeGroup{};
-    ++live_;
-    return g;
-  }
-  void release(std::uint32_t g) {
-    free_.push_back(g);
-    --live_;
-  }
-  NodeGroup& group(std::uint32_t g) { return chunks_[g >> kChunkBits][g & kChunkMask]; }
-  const NodeGroup& group(std::uint32_t g) const { return chunks_[g >> kChunkBits][g & kChunkMask]; }
-  /// Asks the CPU to fetch group g (at most two cache lines) ahead of its use.
-  void prefetch(std::uint32_t g) const {
-    const char* p = reinterpret_cast<const char*>(&group(g));
-    __builtin_prefetch(p);
-    __builtin_prefetch(p + sizeof(NodeGroup) - 1);
-  }
-  std::size_t liveGroups() const { return live_; }
-  /// Bytes of the live groups plus bookkeeping.
-  std::size_t bytes() const { return live_ * sizeof(NodeGroup) + overhead(); }
-  /// Bytes of every allocated chunk plus bookkeeping.
-  std::size_t bytesReserved() const {
-    return chunks_.size() * (std::size_t{1} << kChunkBits) * sizeof(NodeGroup) + overhead();
-  }
-
- private:
-  std::size_t overhead() const {
-    return free_.capacity() * sizeof(std::uint32_t) + chunks_.capacity() * sizeof(void*);
-  }
-  static constexpr std::uint32_t kChunkBits = 8;  // 256 groups (20 KiB) per chunk
-  static constexpr std::uint32_t kChunkMask = (1u << kChunkBits) - 1;
-  void addChunk() { chunks_.emplace_back(new NodeGroup[std::size_t{1} << kChunkBits]); }
-  std::vector<std::unique_ptr<NodeGroup[]>> chunks_;
-  std::vector<std::uint32_t> free_;
-  std::uint32_t next_ = 1;
-  std::size_t live_ = 0;
-};
-
-/// One hashed block: a quadtree of block_levels levels, its average and its root node.
-struct Block {
-  double s = 0.0;          ///< mean log-odds of the block (exact, never lazy)
-  Node root;               ///< valid when has_root
-  bool has_root = false;   ///< false: the block is uniform at s
-  bool known_all = false;  ///< every cell observed
-  bool known_any = false;  ///< some cell observed
-};
-
-inline std::uint64_t blockKey(std::int64_t bx, std::int64_t by) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(bx)) << 32) |
-         static_cast<std::uint64_t>(static_cast<std::uint32_t>(by));
-}
-inline std::int64_t blockKeyX(std::uint64_t key) {
-  return static_cast<std::int32_t>(static_cast<std::uint32_t>(key >> 32));
-}
-inline std::int64_t blockKeyY(std::uint64_t key) {
-  return static_cast<std::int32_t>(static_cast<std::uint32_t>(key & 0xffffffffu));
-}
-struct BlockKeyHash {
-  std::size_t operator()(std::uint64_t k) const {
-    k ^= k >> 33;
-    k *= 0xff51afd7ed558ccdULL;
-    k ^= k >> 33;
-    return static_cast<std::size_t>(k);
-  }
-};
-using BlockMap = std::unordered_map<std::uint64_t, Block, BlockKeyHash>;
-
-/// Floor division for cell -> block indices (arithmetic shift: works for negative cells).
-inline std::int64_t floorShift(std::int64_t v, int bits) { return v >> bits; }
-/// v * 2^bits for any sign (a left shift of a negative value is undefined in C++17).
-inline std::int64_t scaleUp(std::int64_t v, int bits) { return v * (std::int64_t{1} << bits); }
-
 /// Sets or clears `bit` in a knowledge mask.
 inline void setBit(std::uint8_t* mask, std::uint8_t bit, bool on) {
   *mask = static_cast<std::uint8_t>(on ? (*mask | bit) : (*mask & ~bit));
-}
-
-/// Largest stored detail magnitude of a node (stored, without pending tags).
-inline float maxAbsDetail(const Node& n) {
-  const float a = std::fabs(n.d[0]), b = std::fabs(n.d[1]), c = std::fabs(n.d[2]);
-  const float ab = a > b ? a : b;
-  return ab > c ? ab : c;
 }
 
 }  // namespace detail
@@ -196,28 +80,6 @@ struct WaveletMap::Impl {
   bool isTrivial(const detail::Node& n) const {
     return n.child_mask == 0 && detail::maxAbsDetail(n) <= prune_threshold &&
            (n.known_any == 0 || n.known_all == 0xF);
-  }
-
-  /// A temporary node standing for a missing child (a uniform block) about to be refined.
-  static detail::Node uniformSlot(bool all, bool any) {
-    detail::Node n;
-    n.known_all = all ? 0xF : 0;
-    n.known_any = any ? 0xF : 0;
-    return n;
-  }
-  /// After slot node `m` was updated (the stored child when `existed`, else a temporary from
-  /// uniformSlot): reports the slot's knowledge, deletes a stored node that became trivial and
-  /// stores a temporary that did not. install(m) stores a node, remove() deletes the stored one.
-  template <typename Install, typename Remove>
-  void settleSlot(const detail::Node& m, bool existed, bool* all, bool* any, Install install,
-                  Remove remove) {
-    *all = m.known_all == 0xF;
-    *any = m.known_any != 0;
-    if (isTrivial(m)) {
-      if (existed) remove();
-    } else if (!existed) {
-      install(m);
-    }
   }
 
   /// Block lookup (nullptr when absent) and creation (uniform at the prior, unobserved).

@@ -9,23 +9,11 @@
 namespace wavog {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kTwoPi = 2.0 * kPi;
-
-/// Angle wrapped to [-pi, pi).
-double wrap(double a) { return a - kTwoPi * std::floor((a + kPi) / kTwoPi); }
+constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
 
 enum Rank : signed char { kEmpty = -1, kInvalid = 0, kNoReturn = 1, kReturn = 2 };
 
 }  // namespace
-
-Pose2 interpolate(const Pose2& a, const Pose2& b, double f) {
-  Pose2 p;
-  p.x = a.x + f * (b.x - a.x);
-  p.y = a.y + f * (b.y - a.y);
-  p.theta = wrap(a.theta + f * wrap(b.theta - a.theta));
-  return p;
-}
 
 double scanReach(const ScanView& scan, const SensorModelParams& sensor, double resolution) {
   const double range_max =
@@ -59,7 +47,8 @@ ScanView MotionCompensator::compensate(const ScanView& scan, const Pose2& start,
     const double bearing = scan.angle_min + static_cast<double>(i) * inc;
     const Pose2 pose = interpolate(start, end, static_cast<double>(i) / last);
     Rank rank = kInvalid;
-    double new_bearing = bearing + wrap(pose.theta - reference.theta);  // directions only rotate
+    double new_bearing =
+        bearing + wrapAngle(pose.theta - reference.theta);  // directions only rotate
     float value = r;
     if (std::isnan(r) || r <= 0.0f || static_cast<double>(r) < scan.range_min) {
       rank = kInvalid;
@@ -74,7 +63,7 @@ ScanView MotionCompensator::compensate(const ScanView& scan, const Pose2& start,
       const double ry = -sin_r * mx + cos_r * my;
       // Keep the bearing on the same branch as the original one, so fields of view that straddle
       // +-pi bin correctly.
-      new_bearing = bearing + wrap(std::atan2(ry, rx) - bearing);
+      new_bearing = bearing + wrapAngle(std::atan2(ry, rx) - bearing);
       value = static_cast<float>(std::hypot(rx, ry));
       // Moving into the sensor's blind zone or out of its range changes the reading's class;
       // keep it a return only when it still is one.

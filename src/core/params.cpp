@@ -34,27 +34,8 @@ void check(bool ok, const char* name, double value, const char* rule,
 bool usesLowerClamp(PolicyType t) {
   return t == PolicyType::kClamp || t == PolicyType::kClampLower;
 }
-bool usesUpperClamp(PolicyType t) {
-  return t == PolicyType::kClamp || t == PolicyType::kClampUpper;
-}
 
 }  // namespace
-
-const char* toString(ScanStatus status) {
-  switch (status) {
-    case ScanStatus::kOk:
-      return "ok";
-    case ScanStatus::kEmpty:
-      return "empty_scan";
-    case ScanStatus::kBadGeometry:
-      return "bad_geometry";
-    case ScanStatus::kBadPose:
-      return "bad_pose";
-    case ScanStatus::kNoValidBeam:
-      return "no_valid_beam";
-  }
-  return "unknown";
-}
 
 const char* toString(PolicyType type) {
   for (const auto& p : kPolicyNames) {
@@ -116,29 +97,17 @@ std::vector<std::string> MapParams::validate() const {
         "prune_threshold", prune_threshold, "in [0, 1] log-odds", &v);
   check(finite(skip_tolerance) && skip_tolerance >= 0.0 && skip_tolerance <= 1.0, "skip_tolerance",
         skip_tolerance, "in [0, 1] log-odds", &v);
-  // The empty update must be able to move a cell: with a lower clamp, odd_emp cannot be smaller
-  // than the whole clamp interval without making the upper bound unreachable in one step.
-  if (usesLowerClamp(policy.type) && usesUpperClamp(policy.type)) {
-    check(policy.clamp_min < policy.clamp_max, "clamp_min", policy.clamp_min, "< clamp_max", &v);
-  }
+  // clamp_min < clamp_max needs no rule of its own: the two rules above force their signs.
   return v;
 }
 
 MapParams MapParams::defaultsFor(PolicyType type) {
-  MapParams p;
+  MapParams p;  // the field initialisers: the "forget" policy's defaults
   p.policy.type = type;
-  if (type == PolicyType::kForget) {
-    // Fixed points of the forgetting (ALGORITHM.md section 4): asymptotic confidences.
-    p.sensor.odd_occ = 3.5;
-    p.sensor.odd_emp = -2.0;
-  } else {
-    // OctoMap's usual hit 0.7 / miss 0.4 in log-odds; clamp 0.12 / 0.97.
-    p.sensor.odd_occ = 0.85;
-    p.sensor.odd_emp = -0.4;
+  if (type != PolicyType::kForget) {
+    p.sensor.odd_occ = SensorModelParams::kAdditiveOddOcc;
+    p.sensor.odd_emp = SensorModelParams::kAdditiveOddEmp;
   }
-  p.policy.clamp_min = -2.0;
-  p.policy.clamp_max = 3.5;
-  p.policy.gamma = 0.3;
   return p;
 }
 

@@ -10,25 +10,12 @@
 namespace wavog_ros {
 
 const char* toString(DropReason reason) {
-  switch (reason) {
-    case DropReason::kEmpty:
-      return "empty";
-    case DropReason::kSizeMismatch:
-      return "size_mismatch";
-    case DropReason::kBadAngles:
-      return "bad_angles";
-    case DropReason::kBadFrame:
-      return "bad_frame";
-    case DropReason::kTfUnavailable:
-      return "tf_unavailable";
-    case DropReason::kTfTooOld:
-      return "tf_too_old";
-    case DropReason::kNoValidBeam:
-      return "no_valid_beam";
-    case DropReason::kBadGeometry:
-      return "bad_geometry";
-  }
-  return "unknown";
+  // In DropReason order.
+  static constexpr const char* kNames[kNumDropReasons] = {
+      "empty",          "size_mismatch", "bad_angles",    "bad_frame",
+      "tf_unavailable", "tf_too_old",    "no_valid_beam", "bad_geometry"};
+  const auto i = static_cast<std::size_t>(reason);
+  return i < kNumDropReasons ? kNames[i] : "unknown";
 }
 
 bool checkScan(const sensor_msgs::LaserScan& scan, DropReason* reason) {

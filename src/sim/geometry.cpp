@@ -37,16 +37,6 @@ Polygon transformed(const Polygon& local, const Pose2& pose) {
   return out;
 }
 
-Pose2 compose(const Pose2& a, const Pose2& b) {
-  const Vec2 p = transformPoint(a, Vec2(b.x, b.y));
-  return Pose2{p.x(), p.y(), wrapAngle(a.theta + b.theta)};
-}
-
-double wrapAngle(double a) {
-  a = std::remainder(a, 2.0 * M_PI);  // in [-pi, pi]
-  return a <= -M_PI ? a + 2.0 * M_PI : a;
-}
-
 bool pointInPolygon(const Polygon& poly, const Vec2& p) {
   bool inside = false;
   const std::size_t n = poly.size();

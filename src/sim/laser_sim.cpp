@@ -19,12 +19,6 @@ std::uint64_t splitMix64(std::uint64_t* x) {
   return z ^ (z >> 31);
 }
 
-// Angle in [0, 2 pi).
-double positiveAngle(double a) {
-  a = std::fmod(a, 2.0 * M_PI);
-  return a < 0.0 ? a + 2.0 * M_PI : a;
-}
-
 }  // namespace
 
 RayCaster::RayCaster(std::vector<Polygon> polygons) : polygons_(std::move(polygons)) {}
@@ -58,7 +52,8 @@ void RayCaster::castFan(const Pose2& sensor, double angle_min, double angle_incr
       const double aa = std::atan2(a.y(), a.x());
       const double ab = std::atan2(b.y(), b.x());
       const double d = wrapAngle(ab - aa);
-      const double lo = positiveAngle((d >= 0.0 ? aa : ab) - angle_min);
+      // Its start relative to the first beam, in (0, 2 pi] (the loop also tries one turn less).
+      const double lo = wrapAngle((d >= 0.0 ? aa : ab) - angle_min - M_PI) + M_PI;
       const double width = std::abs(d);
       for (double shift : {0.0, -2.0 * M_PI}) {
         const double rel_lo = lo + shift;

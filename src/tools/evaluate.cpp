@@ -24,6 +24,7 @@
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/sim/evaluation.h"
 #include "wavog_mapping/sim/laser_sim.h"
+#include "wavog_mapping/sim/noise_study.h"
 #include "wavog_mapping/sim/world.h"
 #include "wavog_mapping/sim/world_file.h"
 
@@ -46,6 +47,7 @@ struct Options {
   int jobs = 2;                       // policies evaluated in parallel
   std::string offline_summary;        // JSON file embedded as "offline_map" in summary.json
   std::string core_maps;              // also map with the default forgetting config, PNGs here
+  std::string pose_noise = "0:0,2:0.2,5:0.5";  // noise study levels (cm:deg); "none": skip
 };
 
 void usage(std::ostream& out) {
@@ -63,7 +65,10 @@ void usage(std::ostream& out) {
          "  --offline-summary F   embed this JSON (wavog_offline's summary) in summary.json\n"
          "  --core-maps DIR       also map the scenario with the default parameters (forgetting,\n"
          "                        5 cm) through the core and write map_s<scale>.png/.pgm/.yaml\n"
-         "                        for scales 0, 2, 3, 4 there (when wavog_offline is missing)\n";
+         "                        for scales 0, 2, 3, 4 there (when wavog_offline is missing)\n"
+         "  --pose-noise LEVELS   pose-error study of none, max, clamp, forget: a list of\n"
+         "                        SIGMA_XY_CM:SIGMA_YAW_DEG levels (default 0:0,2:0.2,5:0.5;\n"
+         "                        'none' skips it); appended to report.md, also noise.json\n";
 }
 
 Options parseArgs(int argc, char** argv) {
@@ -94,6 +99,8 @@ Options parseArgs(int argc, char** argv) {
       o.offline_summary = v;
     else if (a == "--core-maps")
       o.core_maps = v;
+    else if (a == "--pose-noise")
+      o.pose_noise = v;
     else if (a == "--jobs")
       o.jobs = static_cast<int>(parseNumber(a, v));
     else
@@ -102,6 +109,7 @@ Options parseArgs(int argc, char** argv) {
   if (o.jobs < 1) throw std::invalid_argument("--jobs must be >= 1");
   if (!(o.resolution > 0.0)) throw std::invalid_argument("--resolution must be > 0");
   if (!(o.fraction > 0.0 && o.fraction <= 1.0)) throw std::invalid_argument("--fraction in (0, 1]");
+  if (o.pose_noise != "none") parseNoiseLevels(o.pose_noise, o.seed);  // fails early when bad
   return o;
 }
 
@@ -414,6 +422,43 @@ void printHeadline(const std::vector<WorldEvent>& events,
   std::cout << std::right << std::flush;
 }
 
+// The pose-error study (noise_study.h) over the paper's four policies, appended to report.md.
+void runPoseNoiseStudy(const World& world, const std::vector<SimScan>& scans,
+                       const std::vector<WorldEvent>& events, const std::vector<PolicyRun>& runs,
+                       const std::vector<PolicyResult>& results, const EvaluationOptions& eo,
+                       const Options& o) {
+  const std::vector<NoiseLevel> levels = parseNoiseLevels(o.pose_noise, o.seed);
+  std::vector<PolicyRun> paper_runs;
+  std::vector<PolicyResult> exact;  // today's results of those runs, reused for level 0
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (runs[i].params.policy.init == wavog::InitValue::kUnknown &&
+        runs[i].params.policy.type != wavog::PolicyType::kClampLower) {
+      paper_runs.push_back(runs[i]);
+      exact.push_back(results[i]);
+    }
+  }
+  if (paper_runs.empty()) return;
+  std::cerr << "wavog_evaluate: pose-noise study, " << levels.size() << " levels x "
+            << paper_runs.size() << " policies...\n";
+  const std::vector<NoiseStudyRow> rows =
+      runNoiseStudy(world, scans, events, paper_runs, levels, eo, o.jobs, &exact);
+  std::ofstream(o.out_dir + "/report.md", std::ios::app) << "\n" << noiseStudyMarkdown(rows);
+  std::ofstream(o.out_dir + "/noise.json") << noiseStudyJson(rows);
+  std::cout << "\n"
+            << std::left << std::setw(22) << "pose noise" << std::setw(26) << "policy"
+            << std::setw(11) << "precision" << std::setw(10) << "wall cm" << std::setw(13)
+            << "surface cm"
+            << "wall width (cells)\n";
+  for (const NoiseStudyRow& row : rows) {
+    std::cout << std::setw(22) << row.level << std::setw(26) << row.result.label << std::setw(11)
+              << fixed(row.result.precision, 3) << std::setw(10)
+              << fixed(100 * row.walls.wall_distance_m, 1) << std::setw(13)
+              << fixed(100 * row.walls.surface_distance_m, 1)
+              << fixed(row.walls.width.mean_cells, 2) << "\n";
+  }
+  std::cout << std::right << std::flush;
+}
+
 int run(const Options& o) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
@@ -480,6 +525,7 @@ int run(const Options& o) {
             << "departure.png, arrival.png, summary.json} in " << fixed(wall_s, 1) << " s\n";
   if (!o.core_maps.empty()) writeCoreMaps(world, scans, o.core_maps);
   printHeadline(events, results);
+  if (o.pose_noise != "none") runPoseNoiseStudy(world, scans, events, runs, results, eo, o);
   return 0;
 }
 

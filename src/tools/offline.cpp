@@ -10,7 +10,6 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/LaserScan.h>
 #include <tf2/buffer_core.h>
-#include <tf2/exceptions.h>
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
@@ -38,6 +37,7 @@
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/ros/config.h"
 #include "wavog_mapping/ros/conversions.h"
+#include "wavog_mapping/ros/scan_placement.h"
 
 namespace {
 
@@ -417,6 +417,9 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   std::string first_tf_error;
   std::set<std::string> scan_frames;
   wavog::MotionCompensator compensator;
+  wavog_ros::PlacementOptions placement_options;
+  placement_options.fixed_frame = info.fixed_frame;
+  placement_options.motion_compensation = config.ros.motion_compensation;
   for (const rosbag::MessageInstance& m : scans) {
     if (s.done() >= total) break;
     const auto scan = m.instantiate<sensor_msgs::LaserScan>();
@@ -434,46 +437,19 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
       s.skip(std::string("scan_") + wavog_ros::toString(reason));
       continue;
     }
-    // The same steps as the node (MappingRos): pose at the stamp, mirrored view for an upside-down
-    // laser, motion compensation over the sweep when the scan times its beams.
-    wavog::Pose2 pose0;
-    bool mirrored = false;
-    bool compensate = false;
-    wavog::Pose2 pose1;
-    if (frame != info.fixed_frame) {
-      try {
-        pose0 = wavog_ros::toPose2(
-            tf.lookupTransform(info.fixed_frame, frame, scan->header.stamp).transform, &mirrored);
-      } catch (const tf2::TransformException& e) {
-        if (first_tf_error.empty()) first_tf_error = e.what();
-        const bool extrapolation = dynamic_cast<const tf2::ExtrapolationException*>(&e) != nullptr;
-        s.skip(extrapolation ? "tf_extrapolation" : "tf_unavailable");
-        continue;
-      }
-      const std::size_t n = scan->ranges.size();
-      if (config.ros.motion_compensation && n > 1 && std::isfinite(scan->time_increment) &&
-          scan->time_increment != 0.0f) {
-        const double sweep = static_cast<double>(scan->time_increment) * static_cast<double>(n - 1);
-        try {
-          bool mirrored_end = false;
-          pose1 = wavog_ros::toPose2(
-              tf.lookupTransform(info.fixed_frame, frame, scan->header.stamp + ros::Duration(sweep))
-                  .transform,
-              &mirrored_end);
-          compensate = true;
-        } catch (const tf2::TransformException&) {
-          ++info.motion_fallbacks;
-        }
-      }
+    // The node's placement (scan_placement.h): pose at the first and last beam from tf, mirrored
+    // view for an upside-down laser, motion compensation over the sweep.
+    const wavog_ros::ScanPlacement placement = wavog_ros::placeScan(tf, *scan, placement_options);
+    if (!placement.placed()) {
+      if (first_tf_error.empty()) first_tf_error = placement.error;
+      s.skip(placement.failure == wavog_ros::TfFailure::kExtrapolation ? "tf_extrapolation"
+                                                                        : "tf_unavailable");
+      continue;
     }
-    wavog::ScanView view = wavog_ros::toScanView(*scan);
-    if (mirrored) wavog_ros::mirrorView(&view);
-    wavog::Pose2 pose = pose0;
-    if (compensate) {
-      pose = wavog::interpolate(pose0, pose1, 0.5);
-      view = compensator.compensate(view, pose0, pose1, pose);
-      ++info.motion_compensated;
-    }
+    info.motion_fallbacks += placement.motion_fallback ? 1 : 0;
+    info.motion_compensated += placement.compensate ? 1 : 0;
+    wavog::Pose2 pose;
+    const wavog::ScanView view = placement.placedView(*scan, &compensator, &pose);
     s.integrate(pose, view, scan->header.stamp.toSec());
   }
   s.finish();

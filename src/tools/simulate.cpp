@@ -24,6 +24,7 @@
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/sim/ground_truth.h"
 #include "wavog_mapping/sim/laser_sim.h"
+#include "wavog_mapping/sim/pose_noise.h"
 #include "wavog_mapping/sim/world.h"
 #include "wavog_mapping/sim/world_file.h"
 
@@ -53,6 +54,8 @@ struct Options {
   double truth_resolution = 0.1;
   double truth_every = 10.0;
   std::string write_world;  // write the world as YAML here
+  // Error of the /tf poses (the lasers measure from the true pose).
+  wavog::sim::PoseNoiseParams pose_noise;
 };
 
 void usage(std::ostream& out) {
@@ -70,11 +73,19 @@ void usage(std::ostream& out) {
          "  --truth-dir DIR       write ground truth there: world.yaml, truth_<t>s.png/.pgm/.yaml\n"
          "  --truth-resolution R  ground-truth cell size (m, default 0.1)\n"
          "  --truth-every S       ground-truth snapshot period (s, default 10)\n"
-         "  --write-world FILE    write the world as YAML (e.g. to edit the default) and go on\n";
+         "  --write-world FILE    write the world as YAML (e.g. to edit the default) and go on\n"
+         "  --pose-sigma-xy M     per-scan Gaussian error of the /tf position, x and y (m, 0)\n"
+         "  --pose-sigma-yaw-deg D   per-scan Gaussian error of the /tf heading (deg, 0)\n"
+         "  --pose-drift-x V, --pose-drift-y V   slow linear drift of the /tf position (m/s, 0)\n"
+         "  --pose-drift-yaw-deg W   slow linear drift of the /tf heading (deg/s, 0)\n"
+         "  --pose-seed N         seed of the pose errors (default: --seed)\n"
+         "                        (the lasers always measure from the true pose)\n";
 }
 
 Options parseArgs(int argc, char** argv) {
   Options o;
+  std::uint64_t pose_seed = 0;
+  bool pose_seed_set = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") {
@@ -107,11 +118,25 @@ Options parseArgs(int argc, char** argv) {
       o.truth_every = parseNumber(a, v);
     else if (a == "--write-world")
       o.write_world = v;
+    else if (a == "--pose-sigma-xy")
+      o.pose_noise.sigma_xy_m = parseNumber(a, v);
+    else if (a == "--pose-sigma-yaw-deg")
+      o.pose_noise.sigma_yaw_rad = parseNumber(a, v) * M_PI / 180.0;
+    else if (a == "--pose-drift-x")
+      o.pose_noise.drift_x_m_per_s = parseNumber(a, v);
+    else if (a == "--pose-drift-y")
+      o.pose_noise.drift_y_m_per_s = parseNumber(a, v);
+    else if (a == "--pose-drift-yaw-deg")
+      o.pose_noise.drift_yaw_rad_per_s = parseNumber(a, v) * M_PI / 180.0;
+    else if (a == "--pose-seed")
+      pose_seed = static_cast<std::uint64_t>(parseNumber(a, v)), pose_seed_set = true;
     else
       throw std::invalid_argument("unknown option: " + a);
   }
   if (!(o.truth_resolution > 0.0)) throw std::invalid_argument("--truth-resolution must be > 0");
   if (!(o.truth_every > 0.0)) throw std::invalid_argument("--truth-every must be > 0");
+  o.pose_noise.seed = pose_seed_set ? pose_seed : o.seed;
+  for (const std::string& e : o.pose_noise.validate()) throw std::invalid_argument(e);
   return o;
 }
 
@@ -211,7 +236,8 @@ int run(const Options& o) {
   while (sim.next(&scan)) {
     const ros::Time stamp = t0 + ros::Duration(scan.stamp);
     tf2_msgs::TFMessage tf;
-    tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame, scan.vehicle_pose, stamp));
+    const wavog::Pose2 told = wavog::sim::withPoseError(world, scan, o.pose_noise).vehicle_pose;
+    tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame, told, stamp));
     bag.write("/tf", stamp, tf);
     const LaserParams& laser = world.vehicle.lasers[static_cast<std::size_t>(scan.laser)];
     bag.write(absoluteTopic(laser.topic), stamp, scanMsg(scan, laser, stamp));

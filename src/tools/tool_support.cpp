@@ -16,7 +16,6 @@
 namespace wavog_tools {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kRedrawSeconds = 0.1;
 constexpr int kBarWidth = 30;
 
@@ -29,23 +28,6 @@ std::string formatDuration(double seconds) {
 }
 
 }  // namespace
-
-wavog::Pose2 compose(const wavog::Pose2& a, const wavog::Pose2& b) {
-  const double c = std::cos(a.theta);
-  const double s = std::sin(a.theta);
-  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrapAngle(a.theta + b.theta)};
-}
-
-wavog::Pose2 inverse(const wavog::Pose2& a) {
-  const double c = std::cos(a.theta);
-  const double s = std::sin(a.theta);
-  return {-c * a.x - s * a.y, s * a.x - c * a.y, wrapAngle(-a.theta)};
-}
-
-double wrapAngle(double a) {
-  a = std::remainder(a, 2.0 * kPi);
-  return a <= -kPi ? a + 2.0 * kPi : a;
-}
 
 const CarmenLaser* CarmenLogPlan::laserFor(const std::string& type) const {
   for (const auto& laser : lasers) {

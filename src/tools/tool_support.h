@@ -16,12 +16,10 @@
 
 namespace wavog_tools {
 
-/// a * b: pose b (expressed in frame a) in a's parent frame.
-wavog::Pose2 compose(const wavog::Pose2& a, const wavog::Pose2& b);
-/// The inverse transform of a.
-wavog::Pose2 inverse(const wavog::Pose2& a);
-/// Angle wrapped to (-pi, pi].
-double wrapAngle(double a);
+// Planar pose algebra: the core's (wavog_mapping/core/types.h).
+using wavog::compose;
+using wavog::inverse;
+using wavog::wrapAngle;
 
 /// One laser of a CARMEN log and how it appears in ROS.
 struct CarmenLaser {

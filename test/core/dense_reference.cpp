@@ -11,6 +11,10 @@ namespace wavog_test {
 
 using wavog::PolicyType;
 
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
 DenseReference::DenseReference(const wavog::MapParams& params, const wavog::CellBox& extent)
     : DenseReference(std::vector<wavog::MapParams>{params}, extent) {}
 
@@ -40,101 +44,120 @@ double DenseReference::apply(const wavog::MapParams& p, bool occupied, double x)
   const double o = occupied ? p.sensor.odd_occ : p.sensor.odd_emp;
   const double lo = p.policy.clamp_min, hi = p.policy.clamp_max, g = p.policy.gamma;
   switch (p.policy.type) {
-    case PolicyType::kNone: return x + o;                               // eq. 1.2
-    case PolicyType::kMax: return std::max(x, o);                       // eq. 1.4
-    case PolicyType::kClamp: return std::max(std::min(x + o, hi), lo);  // eq. 1.5
-    case PolicyType::kForget: return (1.0 - g) * x + g * o;             // eq. 1.6
-    case PolicyType::kClampLower: return std::max(x + o, lo);
-    case PolicyType::kClampUpper: return std::min(x + o, hi);
+    case PolicyType::kNone:
+      return x + o;  // eq. 1.2
+    case PolicyType::kMax:
+      return std::max(x, o);  // eq. 1.4
+    case PolicyType::kClamp:
+      return std::max(std::min(x + o, hi), lo);  // eq. 1.5
+    case PolicyType::kForget:
+      return (1.0 - g) * x + g * o;  // eq. 1.6
+    case PolicyType::kClampLower:
+      return std::max(x + o, lo);
+    case PolicyType::kClampUpper:
+      return std::min(x + o, hi);
   }
   return x;
 }
 
-void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& scan) {
-  last_updated_ = 0;
-  const double kPi = 3.14159265358979323846;
+bool ReferenceClassifier::prepare(const wavog::MapParams& p, const wavog::Pose2& pose,
+                                  const wavog::ScanView& scan) {
   // Scans the core refuses change nothing.
   if (scan.count == 0 || !std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
       scan.angle_increment == 0.0 || !std::isfinite(scan.range_min) || scan.range_min < 0 ||
       !(scan.range_max > scan.range_min) ||
       std::fabs(scan.angle_increment) * static_cast<double>(scan.count) > 2 * kPi + 1e-6 ||
       !std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
-    return;
+    return false;
   }
-  const int n = static_cast<int>(scan.count);
-  std::vector<double> ranges(scan.ranges, scan.ranges + n);
-  double amin = scan.angle_min, inc = scan.angle_increment;
-  if (inc < 0) {
-    amin = scan.angle_min + scan.angle_increment * (static_cast<double>(n) - 1.0);
-    inc = -inc;
+  pose_ = pose;
+  n_ = static_cast<int>(scan.count);
+  std::vector<double> ranges(scan.ranges, scan.ranges + n_);
+  amin_ = scan.angle_min;
+  inc_ = scan.angle_increment;
+  if (inc_ < 0) {
+    amin_ = scan.angle_min + scan.angle_increment * (static_cast<double>(n_) - 1.0);
+    inc_ = -inc_;
     std::reverse(ranges.begin(), ranges.end());
   }
-  const double amax = amin + inc * (static_cast<double>(n) - 1.0);
-  const double seam = 0.5 * (amin + amax) - kPi;
-  const double res = p_.grid.resolution;
-  const double sensor_max = p_.sensor.max_range > 0 ? std::min(p_.sensor.max_range, scan.range_max)
-                                                    : scan.range_max;
-  const double half_band = 0.5 * (p_.sensor.band_width > 0 ? p_.sensor.band_width : res);
+  const double amax = amin_ + inc_ * (static_cast<double>(n_) - 1.0);
+  seam_ = 0.5 * (amin_ + amax) - kPi;
+  res_ = p.grid.resolution;
+  const double sensor_max =
+      p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max) : scan.range_max;
+  const double half_band = 0.5 * (p.sensor.band_width > 0 ? p.sensor.band_width : res_);
   const double inf = std::numeric_limits<double>::infinity();
 
   // Per beam: 0 invalid, 1 hit, 2 clearing no-return; E limit and band end.
-  std::vector<int> kind(static_cast<std::size_t>(n), 0);
-  std::vector<double> ze(static_cast<std::size_t>(n), inf), zu(static_cast<std::size_t>(n), -inf);
-  std::set<std::pair<std::int64_t, std::int64_t>> hits;
+  kind_.assign(static_cast<std::size_t>(n_), 0);
+  ze_.assign(static_cast<std::size_t>(n_), inf);
+  zu_.assign(static_cast<std::size_t>(n_), -inf);
+  hits_.clear();
   bool any_valid = false;
-  for (int j = 0; j < n; ++j) {
+  for (int j = 0; j < n_; ++j) {
     const auto ju = static_cast<std::size_t>(j);
     const double z = ranges[ju];
     if (std::isnan(z) || z == -inf || z <= 0 || z < scan.range_min) continue;
     if (z >= sensor_max) {
-      if (p_.sensor.no_return_clear > 0) {
-        kind[ju] = 2;
-        ze[ju] = zu[ju] = p_.sensor.no_return_clear;
+      if (p.sensor.no_return_clear > 0) {
+        kind_[ju] = 2;
+        ze_[ju] = zu_[ju] = p.sensor.no_return_clear;
         any_valid = true;
       }
       continue;
     }
-    kind[ju] = 1;
+    kind_[ju] = 1;
     any_valid = true;
-    ze[ju] = z - half_band;
-    zu[ju] = z + half_band;
-    const double bearing = pose.theta + (amin + static_cast<double>(j) * inc);
+    ze_[ju] = z - half_band;
+    zu_[ju] = z + half_band;
+    const double bearing = pose.theta + (amin_ + static_cast<double>(j) * inc_);
     const double ex = pose.x + z * std::cos(bearing), ey = pose.y + z * std::sin(bearing);
-    hits.emplace(static_cast<std::int64_t>(std::floor(ex / res)),
-                 static_cast<std::int64_t>(std::floor(ey / res)));
+    hits_.emplace(static_cast<std::int64_t>(std::floor(ex / res_)),
+                  static_cast<std::int64_t>(std::floor(ey / res_)));
   }
-  if (!any_valid) return;
+  reach_ = 0;
+  for (int j = 0; j < n_; ++j) reach_ = std::max(reach_, zu_[static_cast<std::size_t>(j)]);
+  return any_valid;
+}
 
+wavog::CellClass ReferenceClassifier::cellClass(std::int64_t ix, std::int64_t iy) const {
+  if (hits_.count({ix, iy})) return wavog::CellClass::kOccupied;
+  const double dx = (static_cast<double>(ix) + 0.5) * res_ - pose_.x;
+  const double dy = (static_cast<double>(iy) + 0.5) * res_ - pose_.y;
+  const double rho = std::sqrt(dx * dx + dy * dy);
+  double beta = std::atan2(dy, dx) - pose_.theta;
+  beta -= 2 * kPi * std::floor((beta - seam_) / (2 * kPi));
+  const long j = std::lround((beta - amin_) / inc_);
+  if (j < 0 || j >= n_ || kind_[static_cast<std::size_t>(j)] == 0)
+    return wavog::CellClass::kUnknown;
+  const auto ju = static_cast<std::size_t>(j);
+  if (rho < ze_[ju]) return wavog::CellClass::kEmpty;
+  if (kind_[ju] == 1 && rho <= zu_[ju]) return wavog::CellClass::kOccupied;
+  return wavog::CellClass::kUnknown;
+}
+
+void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& scan) {
+  last_updated_ = 0;
+  ReferenceClassifier ref;
+  if (!ref.prepare(p_, pose, scan)) return;
   // Cells farther than every band end are U: visit only the box of radius `reach` (plus a cell).
-  double reach = 0;
-  for (int j = 0; j < n; ++j) reach = std::max(reach, zu[static_cast<std::size_t>(j)]);
-  const auto x_lo = std::max(extent_.min_x, static_cast<std::int64_t>(std::floor((pose.x - reach) / res)) - 1);
-  const auto x_hi = std::min(extent_.max_x, static_cast<std::int64_t>(std::floor((pose.x + reach) / res)) + 2);
-  const auto y_lo = std::max(extent_.min_y, static_cast<std::int64_t>(std::floor((pose.y - reach) / res)) - 1);
-  const auto y_hi = std::min(extent_.max_y, static_cast<std::int64_t>(std::floor((pose.y + reach) / res)) + 2);
+  const double reach = ref.reach(), res = p_.grid.resolution;
+  const auto x_lo =
+      std::max(extent_.min_x, static_cast<std::int64_t>(std::floor((pose.x - reach) / res)) - 1);
+  const auto x_hi =
+      std::min(extent_.max_x, static_cast<std::int64_t>(std::floor((pose.x + reach) / res)) + 2);
+  const auto y_lo =
+      std::max(extent_.min_y, static_cast<std::int64_t>(std::floor((pose.y - reach) / res)) - 1);
+  const auto y_hi =
+      std::min(extent_.max_y, static_cast<std::int64_t>(std::floor((pose.y + reach) / res)) + 2);
   for (std::int64_t iy = y_lo; iy < y_hi; ++iy) {
     for (std::int64_t ix = x_lo; ix < x_hi; ++ix) {
-      bool occupied = false, empty = false;
-      if (hits.count({ix, iy})) {
-        occupied = true;
-      } else {
-        const double dx = (static_cast<double>(ix) + 0.5) * res - pose.x;
-        const double dy = (static_cast<double>(iy) + 0.5) * res - pose.y;
-        const double rho = std::sqrt(dx * dx + dy * dy);
-        double beta = std::atan2(dy, dx) - pose.theta;
-        beta -= 2 * kPi * std::floor((beta - seam) / (2 * kPi));
-        const long j = std::lround((beta - amin) / inc);
-        if (j < 0 || j >= n || kind[static_cast<std::size_t>(j)] == 0) continue;
-        const auto ju = static_cast<std::size_t>(j);
-        if (rho < ze[ju]) {
-          empty = true;
-        } else if (kind[ju] == 1 && rho <= zu[ju]) {
-          occupied = true;
-        }
-      }
-      if (!occupied && !empty) continue;
+      const wavog::CellClass cls = ref.cellClass(ix, iy);
+      if (cls == wavog::CellClass::kUnknown) continue;
+      const bool occupied = cls == wavog::CellClass::kOccupied;
       const std::size_t i = index(ix, iy);
-      for (std::size_t k = 0; k < layers_.size(); ++k) v_[k][i] = apply(layers_[k], occupied, v_[k][i]);
+      for (std::size_t k = 0; k < layers_.size(); ++k)
+        v_[k][i] = apply(layers_[k], occupied, v_[k][i]);
       known_[i] = 1;
       ++last_updated_;
     }

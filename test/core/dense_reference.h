@@ -5,12 +5,34 @@
 #define WAVOG_MAPPING_TEST_CORE_DENSE_REFERENCE_H_
 
 #include <cstdint>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/types.h"
 
 namespace wavog_test {
+
+/// The reference's sector model of one scan, cell by cell: std::atan2 bearing, lround to a beam,
+/// sqrt distance against the beam's limits, a hit endpoint in the cell wins (no shortcuts).
+class ReferenceClassifier {
+ public:
+  /// False when the core would refuse the scan or it has no valid beam (nothing is classified).
+  bool prepare(const wavog::MapParams& p, const wavog::Pose2& pose, const wavog::ScanView& scan);
+  /// E, O or U of finest cell (ix, iy).
+  wavog::CellClass cellClass(std::int64_t ix, std::int64_t iy) const;
+  /// Largest band end of the valid beams (m): every cell beyond is U.
+  double reach() const { return reach_; }
+
+ private:
+  wavog::Pose2 pose_;
+  int n_ = 0;
+  double amin_ = 0, inc_ = 0, seam_ = 0, res_ = 0, reach_ = 0;
+  std::vector<int> kind_;  // 0 invalid, 1 hit, 2 clearing no-return
+  std::vector<double> ze_, zu_;
+  std::set<std::pair<std::int64_t, std::int64_t>> hits_;
+};
 
 class DenseReference {
  public:

@@ -24,6 +24,7 @@ struct PolicyRun {
   std::vector<NamedParams> configs;
   std::vector<std::unique_ptr<WaveletMap>> maps;
   std::unique_ptr<DenseReference> ref;
+  std::vector<std::size_t> integrated;  // per map: scans it integrated (status kOk)
 
   PolicyRun(std::vector<NamedParams> c, const CellBox& extent) : configs(std::move(c)) {
     std::vector<MapParams> layers;
@@ -32,13 +33,20 @@ struct PolicyRun {
       layers.push_back(np.params);
     }
     ref = std::make_unique<DenseReference>(layers, extent);
+    integrated.assign(maps.size(), 0);
   }
   void integrate(const OwnedScan& s) {
-    for (auto& m : maps) m->integrate(s.pose, s.view());
+    for (std::size_t i = 0; i < maps.size(); ++i) {
+      if (maps[i]->integrate(s.pose, s.view()).status == wavog::ScanStatus::kOk) ++integrated[i];
+    }
     ref->integrate(s.pose, s.view());
   }
+  // Equal to the reference, and not vacuously: scans were integrated and cells observed (a
+  // regression that refuses every scan, or changes nothing, fails here).
   void expectEqual(const std::string& when) {
     for (std::size_t i = 0; i < maps.size(); ++i) {
+      EXPECT_GT(integrated[i], 0u) << configs[i].name << " " << when;
+      EXPECT_GT(maps[i]->stats(true).observed_cells, 0u) << configs[i].name << " " << when;
       ref->selectLayer(i);
       const Comparison c = compare(*maps[i], *ref);
       EXPECT_LE(c.max_rel_error, kTolerance)
@@ -64,7 +72,8 @@ struct PolicyRun {
         std::size_t known_bad = 0;
         for (std::int64_t by = box.min_y; by < box.max_y; ++by) {
           for (std::int64_t bx = box.min_x; bx < box.max_x; ++bx) {
-            const auto k = static_cast<std::size_t>((by - box.min_y) * box.width() + (bx - box.min_x));
+            const auto k =
+                static_cast<std::size_t>((by - box.min_y) * box.width() + (bx - box.min_x));
             // A mean inherits the float round-off of the cells it averages: the tolerance is
             // relative to the largest of them (unbounded policies reach hundreds).
             const double want_mean = ref->blockMean(s, bx, by);
@@ -102,7 +111,9 @@ TEST(ReferenceEquivalence, RandomScansEveryPolicy) {
     RandomScans scans(1234u + static_cast<std::uint32_t>(levels), half);
     for (int i = 1; i <= 300; ++i) {
       run.integrate(scans.next());
-      if (i == 1 || i == 30 || i == 300) run.expectEqual("levels " + std::to_string(levels) + " after " + std::to_string(i) + " scans");
+      if (i == 1 || i == 30 || i == 300)
+        run.expectEqual("levels " + std::to_string(levels) + " after " + std::to_string(i) +
+                        " scans");
     }
     run.expectMultiscale(std::min(levels, 4));
   }
@@ -120,7 +131,9 @@ TEST(ReferenceEquivalence, DegenerateGeometry) {
     s.angle_increment = kPi / 8;  // 16 beams over 2 pi: beams on the axes and diagonals
     s.range_min = 0.0;
     s.range_max = 5.0;
-    for (int j = 0; j < 16; ++j) s.ranges.push_back(j % 5 == 0 ? std::numeric_limits<float>::infinity() : 1.6f + 0.8f * static_cast<float>(j % 3));
+    for (int j = 0; j < 16; ++j)
+      s.ranges.push_back(j % 5 == 0 ? std::numeric_limits<float>::infinity()
+                                    : 1.6f + 0.8f * static_cast<float>(j % 3));
     run.integrate(s);
   }
   // Beam steps far below any cell's angular size (every bearing index overflows an integer).
@@ -182,7 +195,8 @@ TEST(ReferenceEquivalence, Fr079First500Scans) {
     for (std::size_t j = 0; j < v.count; ++j) {
       const double z = v.ranges[j];
       if (!std::isfinite(z) || z >= v.range_max) continue;
-      const double b = s.laser_pose.theta + v.angle_min + static_cast<double>(j) * v.angle_increment;
+      const double b =
+          s.laser_pose.theta + v.angle_min + static_cast<double>(j) * v.angle_increment;
       x0 = std::min(x0, s.laser_pose.x + z * std::cos(b));
       x1 = std::max(x1, s.laser_pose.x + z * std::cos(b));
       y0 = std::min(y0, s.laser_pose.y + z * std::sin(b));

@@ -146,6 +146,32 @@ ros::Subscriber keepLatest(ros::NodeHandle& nh, const std::string& topic, std::u
                              }));
 }
 
+/// Waits (wall time, at most `timeout` s) until `pub` has `n` subscribers or more.
+inline void waitForSubscribers(const ros::Publisher& pub, std::uint32_t n, double timeout) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (ros::WallTime::now() < end && pub.getNumSubscribers() < n) {
+    ros::WallDuration(0.05).sleep();
+  }
+}
+
+/// Waits (wall time, at most `timeout` s) until the latest message kept by keepLatest() satisfies
+/// `pred`; returns it, or the latest at the timeout (may be null).
+template <typename M, typename Pred>
+boost::shared_ptr<const M> waitLatest(std::mutex* mutex, const boost::shared_ptr<const M>* latest,
+                                      Pred pred, double timeout) {
+  const auto get = [&] {
+    std::lock_guard<std::mutex> lock(*mutex);
+    return *latest;
+  };
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    const auto m = get();
+    if (m && pred(*m)) return m;
+    ros::WallDuration(0.05).sleep();
+  }
+  return get();
+}
+
 }  // namespace room
 
 #endif  // WAVOG_MAPPING_TEST_ROS_ROOM_H_

@@ -27,21 +27,16 @@ nav_msgs::OccupancyGrid::ConstPtr lastMap() {
   std::lock_guard<std::mutex> lock(g_mutex);
   return g_map;
 }
-wavog_mapping::MapperStatus::ConstPtr lastStatus() {
-  std::lock_guard<std::mutex> lock(g_mutex);
-  return g_status;
-}
 
 /// Waits until `pred(status)` holds (or the timeout); returns the last status.
 template <typename Pred>
 wavog_mapping::MapperStatus::ConstPtr waitStatus(Pred pred, double timeout) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    auto s = lastStatus();
-    if (s && s->inputs.size() == 1 && pred(s->inputs[0])) return s;
-    ros::WallDuration(0.05).sleep();
-  }
-  return lastStatus();
+  return room::waitLatest(
+      &g_mutex, &g_status,
+      [&pred](const wavog_mapping::MapperStatus& s) {
+        return s.inputs.size() == 1 && pred(s.inputs[0]);
+      },
+      timeout);
 }
 
 /// A well-formed scan of laser_1 whose every beam sees a phantom wall at 1 m: integrating it
@@ -207,11 +202,7 @@ int main(int argc, char** argv) {
                                                                   &g_mutex, &g_status);
   ros::AsyncSpinner spinner(2);
   spinner.start();
-  // Let the node subscribe before the first scan.
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20);
-  while (ros::WallTime::now() < end && g_scan_pub.getNumSubscribers() == 0) {
-    ros::WallDuration(0.05).sleep();
-  }
+  room::waitForSubscribers(g_scan_pub, 1, 20.0);  // the node, before the first scan
   const int result = RUN_ALL_TESTS();
   running = false;
   tf_thread.join();

@@ -18,20 +18,12 @@ std::mutex g_mutex;
 wavog_mapping::MapperStatus::ConstPtr g_status;
 std::atomic<double> g_sim_time{1000.0};
 
-wavog_mapping::MapperStatus::ConstPtr lastStatus() {
-  std::lock_guard<std::mutex> lock(g_mutex);
-  return g_status;
-}
-
 template <typename Pred>
 wavog_mapping::MapperStatus::ConstPtr waitStatus(Pred pred, double timeout) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    auto s = lastStatus();
-    if (s && s->inputs.size() == 1 && pred(*s)) return s;
-    ros::WallDuration(0.05).sleep();
-  }
-  return lastStatus();
+  return room::waitLatest(
+      &g_mutex, &g_status,
+      [&pred](const wavog_mapping::MapperStatus& s) { return s.inputs.size() == 1 && pred(s); },
+      timeout);
 }
 
 TEST(ClockJump, TfClearedAndMappingGoesOn) {

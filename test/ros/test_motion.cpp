@@ -92,11 +92,7 @@ int main(int argc, char** argv) {
                                                                   &g_mutex, &g_status);
   ros::AsyncSpinner spinner(2);
   spinner.start();
-  // Wait for both mappers to subscribe before sim time starts moving.
-  const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(20.0);
-  while (ros::WallTime::now() < until && scan_pub.getNumSubscribers() < 2) {
-    ros::WallDuration(0.05).sleep();
-  }
+  room::waitForSubscribers(scan_pub, 2, 20.0);  // both mappers, before sim time moves
   tf2_ros::TransformBroadcaster tf;
   tf2_ros::StaticTransformBroadcaster static_tf;
   std::atomic<bool> running{true};

@@ -362,10 +362,7 @@ int main(int argc, char** argv) {
           }));
   ros::AsyncSpinner spinner(2);
   spinner.start();
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20);
-  while (ros::WallTime::now() < end && g_scan_pub.getNumSubscribers() == 0) {
-    ros::WallDuration(0.05).sleep();
-  }
+  room::waitForSubscribers(g_scan_pub, 1, 20.0);
   ros::service::waitForService("wavog_mapping/reset", ros::Duration(20));
   const int result = RUN_ALL_TESTS();
   std::string ignored;

@@ -13,10 +13,6 @@
 
 namespace wavog {
 
-/// Pose at fraction f of the way from a (f = 0) to b (f = 1): linear in position, along the
-/// shorter arc in heading.
-Pose2 interpolate(const Pose2& a, const Pose2& b, double f);
-
 /// Farthest distance (m) from the sensor at which `scan` can change the map under `sensor`: the
 /// longest return (plus the occupied band), or no_return_clear when a beam has no return. Used to
 /// bound the region a scan touched (e.g. for incremental map publication). 0 for an empty scan.

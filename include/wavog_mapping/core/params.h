@@ -22,7 +22,8 @@ enum class PolicyType {
 /// Value of never-observed cells (the map's prior).
 enum class InitValue {
   kUnknown,     ///< "unknown": log-odds 0 (P = 0.5)
-  kEmptyBound,  ///< "empty_bound": the policy's empty bound (clamp_min, or odd_emp), best compression
+  kEmptyBound,  ///< "empty_bound": the policy's empty bound (clamp_min, or odd_emp), best
+                ///< compression
 };
 
 /// Configuration name <-> enum. fromString returns false on an unknown name.
@@ -41,10 +42,17 @@ struct GridParams {
 
 /// Three-valued inverse sensor model (ALGORITHM.md sections 3-4): E / O / U per cell.
 struct SensorModelParams {
-  /// Log-odds added (or, with forgetting, approached) in the occupied band, > 0.
+  /// Log-odds added (or, with forgetting, approached) in the occupied band, > 0. The default is
+  /// the "forget" policy's (its fixed point, ALGORITHM.md section 4); the other policies'
+  /// default is kAdditiveOddOcc.
   double odd_occ = 3.5;
-  /// Log-odds added (or, with forgetting, approached) in free space, < 0.
+  /// Log-odds added (or, with forgetting, approached) in free space, < 0. Default: as odd_occ;
+  /// the other policies' default is kAdditiveOddEmp.
   double odd_emp = -2.0;
+  /// Defaults of odd_occ / odd_emp for every policy but "forget": OctoMap's usual hit 0.7 /
+  /// miss 0.4 as log-odds.
+  static constexpr double kAdditiveOddOcc = 0.85;
+  static constexpr double kAdditiveOddEmp = -0.4;
   /// Width of the occupied band around a hit (m), >= 0; 0 means one cell (the resolution).
   double band_width = 0.0;
   /// Readings beyond this range (m) count as no return; 0 uses each scan's range_max; >= 0.
@@ -87,9 +95,9 @@ struct MapParams {
   /// Every violated rule, one line each, naming the parameter and its valid range. Empty: valid.
   std::vector<std::string> validate() const;
 
-  /// The documented defaults for a policy: odd values, clamp bounds and gamma chosen for it.
-  /// "forget": odd_occ 3.5, odd_emp -2 (fixed points), gamma 0.3. Every other policy:
-  /// odd_occ 0.85, odd_emp -0.4 (OctoMap's 0.7 / 0.4), clamp [-2, 3.5].
+  /// The defaults for a policy: the field initialisers above (the "forget" policy's), with
+  /// type = `type` and, for every other policy, odd_occ / odd_emp = kAdditiveOddOcc /
+  /// kAdditiveOddEmp.
   static MapParams defaultsFor(PolicyType type);
 
   /// Log-odds of a never-observed cell under these parameters.

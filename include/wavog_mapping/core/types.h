@@ -1,5 +1,7 @@
-// Basic value types of the ROS-free core: poses, non-owning scan views, cell indices.
-// Units are SI (metres, radians, seconds). All types are plain values, safe to copy between threads.
+// Basic value types of the ROS-free core: the planar pose and its algebra, non-owning scan views,
+// cell indices, cell classes and scan statuses.
+// Units are SI (metres, radians, seconds). All types are plain values, safe to copy between
+// threads.
 #ifndef WAVOG_MAPPING_CORE_TYPES_H_
 #define WAVOG_MAPPING_CORE_TYPES_H_
 
@@ -14,6 +16,16 @@ struct Pose2 {
   double y = 0.0;
   double theta = 0.0;
 };
+
+/// Angle wrapped to (-pi, pi]. The package's one angle wrap.
+double wrapAngle(double a);
+/// Composition a * b: pose b (given relative to frame a) expressed in a's parent frame.
+Pose2 compose(const Pose2& a, const Pose2& b);
+/// The inverse transform of a: inverse(a) * a is the identity.
+Pose2 inverse(const Pose2& a);
+/// Pose at fraction f of the way from a (f = 0) to b (f = 1): linear in position, along the
+/// shorter arc in heading.
+Pose2 interpolate(const Pose2& a, const Pose2& b, double f);
 
 /// A non-owning view of one planar range scan in its sensor frame, laid out like
 /// sensor_msgs/LaserScan: beam i points at bearing angle_min + i * angle_increment.
@@ -59,10 +71,10 @@ enum class CellClass : std::uint8_t {
 /// Why a whole scan was refused by the core (it then changes nothing).
 enum class ScanStatus : std::uint8_t {
   kOk,
-  kEmpty,           ///< no beams
-  kBadGeometry,     ///< angle_increment zero or non-finite, field of view > 2 pi, bad range limits
-  kBadPose,         ///< non-finite sensor pose
-  kNoValidBeam,     ///< every beam is invalid: nothing to integrate (map unchanged)
+  kEmpty,        ///< no beams
+  kBadGeometry,  ///< angle_increment zero or non-finite, field of view > 2 pi, bad range limits
+  kBadPose,      ///< non-finite sensor pose
+  kNoValidBeam,  ///< every beam is invalid: nothing to integrate (map unchanged)
 };
 
 /// Human-readable name of a ScanStatus, for logs and counters.

@@ -2,8 +2,11 @@
 // average per block, three details per node, a missing child is a uniform block) in a hash of
 // blocks, so it grows without bound in every direction. Scans are integrated coarse to fine with
 // the configured update policy; exponential forgetting uses lazy tags (ALGORITHM.md section 6).
-// Frames: everything is in the map frame; cell (ix, iy) covers [ix, ix+1) x [iy, iy+1) * resolution.
-// Thread-safety: none. Concurrent const calls are safe; any non-const call needs exclusive access.
+// Frames: everything is in the map frame; cell (ix, iy) covers [ix, ix+1) x [iy, iy+1) *
+// resolution. Thread-safety: a map is not synchronised. Concurrent const calls on one map are safe;
+// any non-const call needs exclusive access to that map. integrate() keeps per-thread scratch
+// buffers (a thread_local, reused from scan to scan), so maps used from different threads never
+// share state, and each thread that integrates holds one scan's buffers for its lifetime.
 #ifndef WAVOG_MAPPING_CORE_WAVELET_MAP_H_
 #define WAVOG_MAPPING_CORE_WAVELET_MAP_H_
 
@@ -26,15 +29,18 @@ struct IntegrateStats {
   std::uint32_t beams_invalid = 0;    ///< NaN, -inf, <= 0, < range_min
   std::uint64_t nodes_visited = 0;    ///< tree nodes and finest cells visited
   std::uint32_t blocks_touched = 0;   ///< blocks classified as not U
+  /// Finest cells within the scan's reach (the farthest E or O limit of its beams): every cell
+  /// the scan changed lies in this box. Empty when status != kOk.
+  CellBox touched;
 };
 
 /// Size and work figures of a map.
 struct MapStats {
-  std::size_t blocks = 0;           ///< hashed blocks
-  std::size_t nodes = 0;            ///< live quadtree nodes (each holds 3 details)
-  std::size_t bytes = 0;            ///< bytes used: blocks, live node groups and the hash
-  std::size_t bytes_reserved = 0;   ///< bytes allocated: as `bytes`, but with every pool chunk
-                                    ///< ever allocated (the high-water mark; chunks are not freed)
+  std::size_t blocks = 0;          ///< hashed blocks
+  std::size_t nodes = 0;           ///< live quadtree nodes (each holds 3 details)
+  std::size_t bytes = 0;           ///< bytes used: blocks, live node groups and the hash
+  std::size_t bytes_reserved = 0;  ///< bytes allocated: as `bytes`, but with every pool chunk
+                                   ///< ever allocated (the high-water mark; chunks are not freed)
   std::uint64_t nodes_visited_last = 0;  ///< nodes visited by the last integrate()
   std::uint64_t observed_cells = 0;      ///< finest cells ever observed (only if requested)
 };
@@ -47,10 +53,10 @@ enum class Aggregation {
 
 /// A dense raster of one window at one scale, row-major (row = y, x fastest).
 struct Raster {
-  int scale = 0;                  ///< cells are 2^scale finest cells wide
-  double cell_size = 0.0;         ///< metres per raster cell
-  CellBox box;                    ///< window, in scale-s cell units
-  std::vector<float> log_odds;    ///< per raster cell; the prior where nothing is observed
+  int scale = 0;                    ///< cells are 2^scale finest cells wide
+  double cell_size = 0.0;           ///< metres per raster cell
+  CellBox box;                      ///< window, in scale-s cell units
+  std::vector<float> log_odds;      ///< per raster cell; the prior where nothing is observed
   std::vector<std::uint8_t> known;  ///< 1 if any finest cell under it was ever observed
   double originX() const { return static_cast<double>(box.min_x) * cell_size; }
   double originY() const { return static_cast<double>(box.min_y) * cell_size; }

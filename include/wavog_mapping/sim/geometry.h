@@ -26,10 +26,7 @@ Polygon makeRegular(int n, double radius);
 Polygon transformed(const Polygon& local, const Pose2& pose);
 /// Point `p` (given in the frame of `pose`) expressed in the parent frame.
 Vec2 transformPoint(const Pose2& pose, const Vec2& p);
-/// Composition a * b: pose b (relative to a) expressed in a's parent frame.
-Pose2 compose(const Pose2& a, const Pose2& b);
-/// Angle wrapped to (-pi, pi].
-double wrapAngle(double a);
+// compose() and wrapAngle(): the core's (wavog_mapping/core/types.h).
 
 /// True if `p` lies inside `poly` (even-odd rule; points exactly on an edge may go either way).
 bool pointInPolygon(const Polygon& poly, const Vec2& p);

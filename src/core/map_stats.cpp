@@ -1,0 +1,50 @@
+// Figures of WaveletMap: stats() counts blocks, nodes, bytes used and reserved, the last scan's
+// visits and (on request) the observed cells.
+#include "map_impl.h"
+#include "wavog_mapping/core/wavelet_map.h"
+
+namespace wavog {
+
+using detail::Block;
+using detail::Node;
+
+namespace {
+std::uint64_t countObserved(const WaveletMap::Impl& impl, const Node& n, int l) {
+  std::uint64_t count = 0;
+  for (int q = 0; q < 4; ++q) {
+    if (l > 1 && impl.hasChild(n, q)) {
+      count += countObserved(impl, impl.child(n, q), l - 1);
+    } else if ((n.known_all >> q) & 1u) {
+      count += std::uint64_t{1} << (2 * (l - 1));
+    }
+  }
+  return count;
+}
+}  // namespace
+
+MapStats WaveletMap::stats(bool count_observed) const {
+  const Impl& impl = *impl_;
+  MapStats st;
+  st.blocks = impl.blocks.size();
+  st.nodes = impl.nodes;
+  // Hash: one heap node per block (key, Block, next pointer, cached hash) plus the bucket array.
+  const std::size_t per_block = sizeof(std::uint64_t) + sizeof(Block) + 2 * sizeof(void*);
+  const std::size_t rest =
+      impl.blocks.size() * per_block + impl.blocks.bucket_count() * sizeof(void*) + sizeof(Impl);
+  st.bytes = impl.pool.bytes() + rest;
+  st.bytes_reserved = impl.pool.bytesReserved() + rest;
+  st.nodes_visited_last = impl.nodes_visited_last;
+  if (count_observed) {
+    for (const auto& kv : impl.blocks) {
+      const Block& b = kv.second;
+      if (b.has_root) {
+        st.observed_cells += countObserved(impl, b.root, impl.levels);
+      } else if (b.known_all) {
+        st.observed_cells += std::uint64_t{1} << (2 * impl.levels);
+      }
+    }
+  }
+  return st;
+}
+
+}  // namespace wavog

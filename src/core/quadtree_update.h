@@ -1,0 +1,200 @@
+// The quadtree update of one scan (ALGORITHM.md sections 3 and 6): Integrator<P> walks a block
+// coarse to fine against the ScanClassifier's classes. U is skipped, E is applied at the slot's
+// own scale (a lazy tag with forgetting), the rest descends; the children's average changes fold
+// into the parent's details with one forward Haar step. Not installed; included only by
+// src/core/integrate.cpp.
+#ifndef WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
+#define WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "map_slot.h"
+#include "scan_classifier.h"
+#include "update_policy.h"
+#include "wavog_mapping/core/haar.h"
+
+namespace wavog {
+namespace detail {
+
+template <PolicyType P>
+class Integrator {
+ public:
+  Integrator(WaveletMap::Impl& impl, const ScanClassifier& classifier, const PolicyConsts& pc)
+      : impl_(impl), cls_(classifier), pc_(pc), lazy_(impl.params.lazy_forgetting) {}
+
+  /// Tree nodes and finest cells visited so far.
+  std::uint64_t visited() const { return visited_; }
+
+  /// Updates block `b` (origin cell ix0, iy0) classified as `box`.
+  void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) {
+    RootSlot slot(impl_, b);
+    const double s = b.s;
+    b.s += updateSlot(slot, box.cls, s,
+                      [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
+  }
+
+ private:
+  // The rules of one slot of class `cls` whose average is s (U skipped, E at the slot's own
+  // scale, the section 3.4 skip); descend(m) updates the slot's node m (the stored one, or a
+  // temporary uniform one) when the slot must be refined, and returns the change of its average.
+  // Returns the change of the slot's average.
+  template <typename Slot, typename Descend>
+  [[gnu::always_inline]] double updateSlot(Slot& slot, CellClass cls, double s, Descend descend) {
+    Node* node = slot.node();
+    switch (cls) {
+      case CellClass::kUnknown:
+        return 0.0;
+      case CellClass::kEmpty:
+        if (node == nullptr) {  // uniform block: exact for every policy
+          slot.setKnown(true, true);
+          return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
+        }
+        if (kAffineEmpty<P> && node->known_all == 0xF) {
+          if constexpr (P == PolicyType::kForget) forgetSubtree(slot, node);
+          slot.setKnown(true, true);
+          return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
+        }
+        break;  // detail below (non-affine policy) or knowledge still to record: descend
+      case CellClass::kFreeOrUnknown:
+        // ALGORITHM.md 3.4: the E part would not change a uniform, fully known block.
+        if (node == nullptr && slot.knownAll() &&
+            std::fabs(applyPolicy<P>(pc_, CellClass::kEmpty, s) - s) <= pc_.unchanged_tol) {
+          return 0.0;
+        }
+        break;
+      default:
+        break;
+    }
+    return refineSlot(slot, node, descend);
+  }
+
+  // The multiplicative part of an E update of a fully known subtree with forgetting: a lazy tag
+  // (ALGORITHM.md 6.3; the additive part reaches the parent through the average), or eagerly.
+  template <typename Slot>
+  void forgetSubtree(Slot& slot, Node* node) {
+    if (!lazy_) {
+      scaleSubtree(*node);
+      return;
+    }
+    impl_.addPending(*node, 1);
+    if (node->k >= impl_.k_star) slot.remove();  // section 6.5: subtree negligible
+  }
+
+  // Descends through node n (level l, average s): flushes its tag (F1), updates its 4 children,
+  // folds their average changes into n's details with one forward Haar step.
+  double visitNode(Node& n, const SquareInfo& box, int l, std::int64_t ix0, std::int64_t iy0,
+                   double s) {
+    ++visited_;
+    impl_.flush(n);
+    // The children are read after the (long) classification: fetch them meanwhile.
+    if (n.children != 0) impl_.pool.prefetch(n.children);
+    if (l == 1) return visitLeafParent(n, box, ix0, iy0, s);
+    if (l == 2 && ScanClassifier::fewSectors(box)) return visitLevel2(n, box, ix0, iy0, s);
+    const std::array<double, 4> c = haar::backward(s, n.d);
+    std::array<double, 4> delta{};
+    const std::int64_t half = std::int64_t{1} << (l - 1);
+    for (int q = 0; q < 4; ++q) {
+      const auto qu = static_cast<std::size_t>(q);
+      const std::int64_t cx = ix0 + ((q & 1) ? half : 0), cy = iy0 + ((q & 2) ? half : 0);
+      const SquareInfo child_box = cls_.classifySquare(l - 1, cx, cy, box);
+      ++visited_;
+      if (child_box.cls == CellClass::kUnknown) continue;
+      ChildSlot slot(impl_, n, q);
+      delta[qu] = updateSlot(slot, child_box.cls, c[qu], [&](Node& m) {
+        return visitNode(m, child_box, l - 1, cx, cy, c[qu]);
+      });
+    }
+    return foldChanges(n, delta);
+  }
+
+  // A level-1 node: its children are finest cells.
+  double visitLeafParent(Node& n, const SquareInfo& box, std::int64_t ix0, std::int64_t iy0,
+                         double s) {
+    CellMasks cells;
+    for (unsigned q = 0; q < 4; ++q) {
+      const CellClass cls = cls_.classifyCell(ix0 + static_cast<std::int64_t>(q & 1),
+                                              iy0 + static_cast<std::int64_t>(q >> 1), box);
+      cells.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << q;
+      cells.o |= static_cast<std::uint32_t>(cls == CellClass::kOccupied) << q;
+    }
+    return updateCells(n, cells, s);
+  }
+
+  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), cell q
+  // E or O by bit q of `cells` (U when in neither); returns the change of n's average.
+  double updateCells(Node& n, const CellMasks& cells, double s) {
+    visited_ += 4;
+    const std::array<double, 4> c = haar::backward(s, n.d);
+    std::array<double, 4> delta{};
+    for (std::size_t q = 0; q < 4; ++q) {
+      if ((cells.e >> q) & 1u) {
+        delta[q] = applyPolicy<P>(pc_, CellClass::kEmpty, c[q]) - c[q];
+      } else if ((cells.o >> q) & 1u) {
+        delta[q] = applyPolicy<P>(pc_, CellClass::kOccupied, c[q]) - c[q];
+      }
+    }
+    const auto known = static_cast<std::uint8_t>(cells.e | cells.o);
+    n.known_all = static_cast<std::uint8_t>(n.known_all | known);
+    n.known_any = static_cast<std::uint8_t>(n.known_any | known);
+    return foldChanges(n, delta);
+  }
+
+  // A level-2 node (4 x 4 finest cells, tag flushed): its 16 cells are classified together
+  // (cheaply when the square lies in one or a few sectors) and each level-1 child slot takes the
+  // class of its 4 cells, exactly, instead of a conservative square test of its own.
+  double visitLevel2(Node& n, const SquareInfo& box, std::int64_t ix0, std::int64_t iy0, double s) {
+    const CellMasks cells = cls_.classify4x4(ix0, iy0, box);  // cell (x, y) at bit x + 4 y
+    const std::array<double, 4> c = haar::backward(s, n.d);
+    std::array<double, 4> delta{};
+    for (int q = 0; q < 4; ++q) {
+      ++visited_;
+      const auto qu = static_cast<std::size_t>(q);
+      // The slot's cells (x, y), x, y in {0, 1}, as bits x + 2 y.
+      const unsigned shift = static_cast<unsigned>((q & 1) * 2 + (q >> 1) * 8);
+      const CellMasks cc{quad(cells.e >> shift), quad(cells.o >> shift)};
+      const CellClass cls = slotClass(cc);
+      if (cls == CellClass::kUnknown) continue;
+      ChildSlot slot(impl_, n, q);
+      delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
+        ++visited_;
+        impl_.flush(m);
+        return updateCells(m, cc, c[qu]);
+      });
+    }
+    return foldChanges(n, delta);
+  }
+
+  // Bits 0, 1, 4, 5 of a 4 x 4 mask (a 2 x 2 corner) as bits 0..3.
+  static std::uint32_t quad(std::uint32_t bits) { return (bits & 3u) | ((bits >> 2) & 0xCu); }
+
+  // The exact class of a 2 x 2 square from its cells' classes.
+  static CellClass slotClass(const CellMasks& cc) {
+    if (cc.o != 0) return CellClass::kMixed;
+    if (cc.e == 0xFu) return CellClass::kEmpty;
+    return cc.e == 0 ? CellClass::kUnknown : CellClass::kFreeOrUnknown;
+  }
+
+  // Eager forgetting (lazy tags off): every detail of the subtree times a, now.
+  void scaleSubtree(Node& n) {
+    ++visited_;
+    const auto a = static_cast<float>(pc_.a);
+    for (float& d : n.d) d *= a;
+    if (n.children == 0) return;
+    for (int q = 0; q < 4; ++q) {
+      if (impl_.hasChild(n, q)) scaleSubtree(impl_.child(n, q));
+    }
+  }
+
+  WaveletMap::Impl& impl_;
+  const ScanClassifier& cls_;
+  const PolicyConsts pc_;
+  const bool lazy_;
+  std::uint64_t visited_ = 0;
+};
+
+}  // namespace detail
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_

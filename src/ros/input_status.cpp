@@ -1,0 +1,77 @@
+// The counter table of an input (see input_status.h): one row per counter, with its ~status
+// field and its /diagnostics label.
+#include "input_status.h"
+
+namespace wavog_ros {
+namespace {
+
+using wavog_mapping::InputStatus;
+
+struct CounterRow {
+  Counter counter;
+  const char* label;  ///< /diagnostics key
+  InputStatus::_received_type InputStatus::*field;
+};
+
+constexpr CounterRow kRows[] = {
+    {Counter::kReceived, "received", &InputStatus::received},
+    {Counter::kIntegrated, "integrated", &InputStatus::integrated},
+    {droppedCounter(DropReason::kEmpty), "dropped empty", &InputStatus::dropped_empty},
+    {droppedCounter(DropReason::kSizeMismatch), "dropped size_mismatch",
+     &InputStatus::dropped_size_mismatch},
+    {droppedCounter(DropReason::kBadAngles), "dropped bad_angles", &InputStatus::dropped_bad_angles},
+    {droppedCounter(DropReason::kBadFrame), "dropped bad_frame", &InputStatus::dropped_bad_frame},
+    {droppedCounter(DropReason::kTfUnavailable), "dropped tf_unavailable",
+     &InputStatus::dropped_tf_unavailable},
+    {droppedCounter(DropReason::kTfTooOld), "dropped tf_too_old", &InputStatus::dropped_tf_too_old},
+    {droppedCounter(DropReason::kNoValidBeam), "dropped no_valid_beam",
+     &InputStatus::dropped_no_valid_beam},
+    {droppedCounter(DropReason::kBadGeometry), "dropped bad_geometry",
+     &InputStatus::dropped_bad_geometry},
+    {Counter::kTimeJumps, "time jumps", &InputStatus::time_jumps},
+    {Counter::kMotionFallbacks, "motion fallbacks", &InputStatus::motion_fallbacks},
+    {Counter::kBeamsInvalid, "beams invalid", &InputStatus::beams_invalid},
+    {Counter::kBeamsNoReturn, "beams no return", &InputStatus::beams_no_return},
+};
+static_assert(sizeof(kRows) / sizeof(kRows[0]) == kNumCounters, "one row per counter");
+
+constexpr bool rowsInCounterOrder() {
+  for (std::size_t i = 0; i < kNumCounters; ++i) {
+    if (static_cast<std::size_t>(kRows[i].counter) != i) return false;
+  }
+  return true;
+}
+static_assert(rowsInCounterOrder(), "row i is counter i");
+
+}  // namespace
+
+std::uint64_t InputCounters::dropped() const {
+  std::uint64_t n = 0;
+  for (std::size_t r = 0; r < kNumDropReasons; ++r) {
+    n += (*this)[droppedCounter(static_cast<DropReason>(r))];
+  }
+  return n;
+}
+
+std::uint64_t InputCounters::tfFailures() const {
+  return (*this)[droppedCounter(DropReason::kTfUnavailable)] +
+         (*this)[droppedCounter(DropReason::kTfTooOld)];
+}
+
+InputStatus toInputStatus(const InputCounters& c, const std::string& topic,
+                          double expected_rate) {
+  InputStatus s;
+  s.topic = topic;
+  for (const CounterRow& row : kRows) s.*row.field = c[row.counter];
+  s.last_stamp = c.last_stamp;
+  s.rate = c.rate;
+  s.expected_rate = expected_rate;
+  return s;
+}
+
+void addCounters(const InputCounters& c, diagnostic_updater::DiagnosticStatusWrapper* stat) {
+  for (const CounterRow& row : kRows) stat->add(row.label, c[row.counter]);
+  stat->add("dropped", c.dropped());
+}
+
+}  // namespace wavog_ros

@@ -1,0 +1,65 @@
+// The counters of one LaserScan input and the one table that names them: the ~status message
+// (InputStatus fields) and /diagnostics (labels) are both written from it, so the two cannot list
+// different counters. Plain values; the caller (MappingRos) guards them with its lock.
+#ifndef WAVOG_MAPPING_SRC_ROS_INPUT_STATUS_H_
+#define WAVOG_MAPPING_SRC_ROS_INPUT_STATUS_H_
+
+#include <diagnostic_updater/DiagnosticStatusWrapper.h>
+#include <ros/time.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "wavog_mapping/InputStatus.h"
+#include "wavog_mapping/ros/conversions.h"
+
+namespace wavog_ros {
+
+/// Every counter of an input, in msg/InputStatus.msg order. The dropped ones follow DropReason.
+enum class Counter : std::size_t {
+  kReceived,
+  kIntegrated,
+  kDroppedFirst,  ///< + DropReason: dropped_empty ... dropped_bad_geometry
+  kTimeJumps = kDroppedFirst + kNumDropReasons,
+  kMotionFallbacks,
+  kBeamsInvalid,
+  kBeamsNoReturn,
+};
+constexpr std::size_t kNumCounters = static_cast<std::size_t>(Counter::kBeamsNoReturn) + 1;
+
+/// The counter of scans dropped for `reason`.
+constexpr Counter droppedCounter(DropReason reason) {
+  return static_cast<Counter>(static_cast<std::size_t>(Counter::kDroppedFirst) +
+                              static_cast<std::size_t>(reason));
+}
+
+/// Counters and clocks of one input since start-up.
+struct InputCounters {
+  std::array<std::uint64_t, kNumCounters> count{};
+  std::uint64_t received_in_period = 0;  ///< for the measured rate in ~status
+  ros::Time last_stamp;                  ///< of the last integrated scan
+  ros::Time last_received_stamp;         ///< of the last received scan (time-jump check)
+  ros::Time last_receipt;                ///< clock time of the last receipt (stale check)
+  double rate = 0.0;                     ///< measured over the last status period (Hz)
+
+  std::uint64_t& operator[](Counter c) { return count[static_cast<std::size_t>(c)]; }
+  std::uint64_t operator[](Counter c) const { return count[static_cast<std::size_t>(c)]; }
+  /// Scans dropped for any reason.
+  std::uint64_t dropped() const;
+  /// Scans dropped because tf was unavailable or too old (MapperStatus::tf_failures).
+  std::uint64_t tfFailures() const;
+};
+
+/// The ~status entry of one input: every counter of the table, the stamps and the rates.
+wavog_mapping::InputStatus toInputStatus(const InputCounters& c, const std::string& topic,
+                                         double expected_rate);
+
+/// Adds every counter of the table to a diagnostic status ("received", "dropped empty", ...),
+/// then the total "dropped".
+void addCounters(const InputCounters& c, diagnostic_updater::DiagnosticStatusWrapper* stat);
+
+}  // namespace wavog_ros
+
+#endif  // WAVOG_MAPPING_SRC_ROS_INPUT_STATUS_H_

@@ -1,0 +1,82 @@
+// Publication of the map: the `map` layer (latched) and the map_scale_<s> layers, cut to a window
+// around the robot or the whole map; map_updates, the changed rectangle of the finest layer, from
+// one dirty region. Reads happen under the caller's lock (MappingRos::Impl::mutex_, which guards
+// this object and the map); publish() and publishUpdate() run without it.
+#ifndef WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
+#define WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
+
+#include <ros/node_handle.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "wavog_mapping/core/wavelet_map.h"
+#include "wavog_mapping/ros/config.h"
+
+namespace wavog_ros {
+
+/// An axis-aligned box of the map frame (m).
+struct MapBox {
+  double min_x = 0.0, min_y = 0.0, max_x = 0.0, max_y = 0.0;
+};
+
+/// The part of the finest layer changed since the last map_updates message.
+struct DirtyRegion {
+  bool any = false;
+  MapBox box;
+  /// Grows the region to hold `b`.
+  void add(const MapBox& b);
+};
+
+/// The layers of one full publication, read from the map.
+struct Layers {
+  struct Layer {
+    int scale;
+    ros::Publisher pub;
+    wavog::Raster raster;
+  };
+  std::vector<Layer> layers;
+};
+
+class MapPublisher {
+ public:
+  /// Advertises map, map_updates and map_scale_<s> for `scales` on `nh`.
+  MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales);
+
+  /// Publishes map_scale_<s> for exactly `scales` (publishers of kept scales are kept).
+  void advertiseScales(const std::vector<int>& scales);
+  /// The scales published besides `map` (scale 0).
+  std::vector<int> scales() const;
+
+  /// The scan or the service changed the map inside `box`.
+  void touched(const MapBox& box) { dirty_.add(box); }
+  /// The next map_updates carries the whole last full grid (after a reset).
+  void markAllDirty(double resolution);
+
+  /// Reads `map` and every layer with subscribers, within `window` (half-width w around cx, cy)
+  /// when w > 0, else the whole map. Caller's lock.
+  Layers read(const wavog::WaveletMap& map, const RosParams& params, double cx, double cy);
+  /// Publishes what read() returned. No lock needed.
+  static void publish(const Layers& layers, const std::string& frame, const ros::Time& stamp);
+
+  bool updateWanted() const { return update_pub_.getNumSubscribers() > 0; }
+  /// Reads the dirty region, clipped to the last full `map`, and clears it; false if there is
+  /// nothing to send. Caller's lock.
+  bool readUpdate(const wavog::WaveletMap& map, wavog::Raster* raster, wavog::CellBox* full);
+  /// Publishes what readUpdate() returned. No lock needed.
+  void publishUpdate(const wavog::Raster& raster, const wavog::CellBox& full,
+                     const std::string& frame, const ros::Time& stamp) const;
+
+ private:
+  ros::NodeHandle nh_;
+  ros::Publisher map_pub_, update_pub_;
+  std::map<int, ros::Publisher> scale_pubs_;
+  DirtyRegion dirty_;
+  bool have_full_ = false;
+  wavog::CellBox last_full_box_;  ///< scale-0 box of the last full `map`
+};
+
+}  // namespace wavog_ros
+
+#endif  // WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_

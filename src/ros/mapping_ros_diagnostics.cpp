@@ -1,0 +1,70 @@
+// MappingRos's /diagnostics: one status per input (received, stale, integrating; every counter of
+// the table in input_status.h) and one for the mapper (tf failures, keeping up, map size).
+#include <algorithm>
+
+#include "mapping_ros_impl.h"
+
+namespace wavog_ros {
+namespace {
+
+/// An input is stale after this many expected periods without a scan (or as many seconds when
+/// no rate is expected), and never sooner than kMinStaleSeconds.
+constexpr double kStalePeriods = 5.0;
+constexpr double kMinStaleSeconds = 0.5;
+/// Integration busier than this fraction of the expected scan rate cannot keep up.
+constexpr double kBusyFraction = 0.8;
+
+}  // namespace
+
+void MappingRos::Impl::diagnoseInput(const Input* in,
+                                     diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const InputCounters& c = in->c;
+  const double since = (ros::Time::now() - c.last_receipt).toSec();
+  const double expected = in->config.expected_rate;
+  const double stale_after = expected > 0.0 ? kStalePeriods / expected : kStalePeriods;
+  if (c[Counter::kReceived] == 0) {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no scan received yet");
+  } else if (since > std::max(stale_after, kMinStaleSeconds)) {
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "stale: no scan for %.1f s", since);
+  } else if (c[Counter::kIntegrated] == 0) {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "scans received but none integrated");
+  } else {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "integrating");
+  }
+  addCounters(c, &stat);
+  stat.add("measured rate (Hz)", c.rate);
+  stat.add("expected rate (Hz)", expected);
+}
+
+void MappingRos::Impl::diagnoseMapper(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::uint64_t tf_failures = 0;
+  double expected_total = 0.0;
+  for (const auto& in : inputs_) {
+    tf_failures += in->c.tfFailures();
+    expected_total += in->config.expected_rate;
+  }
+  const std::uint64_t new_failures = tf_failures - tf_failures_reported_;
+  tf_failures_reported_ = tf_failures;
+  if (new_failures > 0) {
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu tf failures since last report",
+                  static_cast<unsigned long long>(new_failures));
+  } else if (expected_total > 0.0 && last_mean_ * expected_total > kBusyFraction) {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                 "integration cannot keep up with the expected scan rate");
+  } else {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "ok");
+  }
+  stat.add("tf failures", tf_failures);
+  stat.add("clock jumps", clock_jumps_);
+  stat.add("integration time mean (s)", last_mean_);
+  stat.add("integration time max (s)", last_max_);
+  stat.add("publish time (s)", publish_time_);
+  const wavog::MapStats ms = map_.stats();
+  stat.add("blocks", ms.blocks);
+  stat.add("nodes", ms.nodes);
+  stat.add("bytes", ms.bytes);
+}
+
+}  // namespace wavog_ros

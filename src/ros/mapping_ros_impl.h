@@ -1,0 +1,139 @@
+// MappingRos::Impl: the state of the mapper and which lock guards what. Its methods are split by
+// role: mapping_ros.cpp (construction: inputs, tf, publishers, services, reconfigure, timers),
+// mapping_ros_scans.cpp (one scan, from the callback to the core call), mapping_ros_publish.cpp
+// (timers: layers, map_updates, ~status), mapping_ros_diagnostics.cpp (/diagnostics),
+// mapping_ros_services.cpp (~reset, ~clear_region, ~save_map).
+#ifndef WAVOG_MAPPING_SRC_ROS_MAPPING_ROS_IMPL_H_
+#define WAVOG_MAPPING_SRC_ROS_MAPPING_ROS_IMPL_H_
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <dynamic_reconfigure/server.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <std_srvs/Empty.h>
+#include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
+
+#include <array>
+#include <boost/thread/recursive_mutex.hpp>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "input_status.h"
+#include "map_publisher.h"
+#include "wavog_mapping/ClearRegion.h"
+#include "wavog_mapping/MapperStatus.h"
+#include "wavog_mapping/MappingConfig.h"
+#include "wavog_mapping/SaveMap.h"
+#include "wavog_mapping/core/motion_compensation.h"
+#include "wavog_mapping/core/wavelet_map.h"
+#include "wavog_mapping/ros/config.h"
+#include "wavog_mapping/ros/mapping_ros.h"
+#include "wavog_mapping/ros/scan_placement.h"
+
+namespace wavog_ros {
+
+using ScanFilter = tf2_ros::MessageFilter<sensor_msgs::LaserScan>;
+
+/// Seconds between two warnings of the same input and reason.
+constexpr double kWarnPeriod = 5.0;
+
+/// One LaserScan input: its subscription, its tf filter and its counters.
+struct Input {
+  InputConfig config;
+  std::string topic;  ///< resolved name
+  ros::Subscriber sub;
+  std::unique_ptr<ScanFilter> filter;
+  InputCounters c;  ///< guarded by Impl::mutex_
+  std::array<ros::WallTime, kNumDropReasons + 1> last_warn;  ///< + 1: time jumps, fallbacks
+  double min_freq = 0.0;  ///< diagnostics bounds (the FrequencyStatus keeps pointers to them)
+  double max_freq = 0.0;
+  diagnostic_updater::FrequencyStatus* freq = nullptr;  ///< owned by Impl::freq_; may be null
+};
+
+struct MappingRos::Impl {
+  Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+  ~Impl();
+
+  // ---- construction (mapping_ros.cpp)
+  void subscribeTf();
+  void addInput(const InputConfig& ic);
+  void startReconfigure();
+  void startTimers();
+  void onReconfigure(wavog_mapping::MappingConfig& rc, std::uint32_t level);
+
+  // ---- one scan (mapping_ros_scans.cpp), in the order a scan passes them
+  void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan);
+  void onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static);
+  void onFilterFailure(Input* in, tf2_ros::filter_failure_reasons::FilterFailureReason reason);
+  void onTransformable(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan);
+  void integrateLocked(Input* in, const sensor_msgs::LaserScan& scan,
+                       const ScanPlacement& placement);
+  void dropLocked(Input* in, DropReason reason, const std::string& detail);
+  void warnLocked(Input* in, std::size_t slot, const std::string& text);
+
+  // ---- publication and status (mapping_ros_publish.cpp)
+  void onPublishTimer(const ros::TimerEvent&);
+  void onUpdateTimer(const ros::TimerEvent&);
+  wavog_mapping::MapperStatus::Ptr statusLocked(const ros::Time& now);
+
+  // ---- /diagnostics (mapping_ros_diagnostics.cpp)
+  void diagnoseInput(const Input* in, diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnoseMapper(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  // ---- services (mapping_ros_services.cpp)
+  bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
+  bool onClearRegion(wavog_mapping::ClearRegion::Request& req,
+                     wavog_mapping::ClearRegion::Response& res);
+  bool onSaveMap(wavog_mapping::SaveMap::Request& req, wavog_mapping::SaveMap::Response& res);
+
+  ros::NodeHandle nh_, pnh_;
+  Config config_;  ///< the run-time part changes only in onReconfigure(); guarded by mutex_
+  PlacementOptions placement_;  ///< constant after construction
+
+  // tf first: the filters (in inputs_) refer to the buffer and are destroyed before it.
+  std::unique_ptr<tf2_ros::Buffer> buffer_;
+  /// Our own /tf and /tf_static subscribers instead of tf2_ros::TransformListener: Debian's
+  /// tf2_ros (0.7.6) MessageFilter::add() registers its transformable request before queueing the
+  /// message, so a transform inserted by another thread in between notifies nobody and the scan
+  /// waits in the filter forever (seen in fast bag playback: a few scans of 300 never processed).
+  /// tf_mutex_ serialises tf insertion with MessageFilter::add() and buffer clearing.
+  std::mutex tf_mutex_;
+  ros::Subscriber tf_sub_, tf_static_sub_;
+
+  /// The one lock: map_, compensator_, publisher_, every Input::c, the statistics and config_.
+  /// Never held while publishing or while waiting on tf.
+  std::mutex mutex_;
+  wavog::WaveletMap map_;
+  wavog::MotionCompensator compensator_;
+  std::vector<std::unique_ptr<Input>> inputs_;
+  ros::Time last_now_;  ///< clock at the last scan (backwards-jump check)
+  std::uint64_t clock_jumps_ = 0;
+  // Integration time over the current status period.
+  double integrate_time_sum_ = 0.0;
+  double integrate_time_max_ = 0.0;
+  std::uint64_t integrate_count_ = 0;
+  double last_mean_ = 0.0, last_max_ = 0.0;  ///< of the last finished period (diagnostics)
+  double publish_time_ = 0.0;
+  ros::Time last_status_time_;
+  std::uint64_t tf_failures_reported_ = 0;  ///< tf failures at the last diagnostics update
+  std::unique_ptr<MapPublisher> publisher_;
+
+  ros::Publisher status_pub_;
+  ros::ServiceServer reset_srv_, clear_srv_, save_srv_;
+  ros::Timer publish_timer_, update_timer_, diag_timer_;
+
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  std::vector<std::unique_ptr<diagnostic_updater::FrequencyStatus>> freq_;
+
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<wavog_mapping::MappingConfig>> reconfigure_;
+};
+
+}  // namespace wavog_ros
+
+#endif  // WAVOG_MAPPING_SRC_ROS_MAPPING_ROS_IMPL_H_

@@ -1,0 +1,93 @@
+// MappingRos's timers: the full publication of every layer with the ~status of the period that
+// ends (onPublishTimer), and map_updates (onUpdateTimer). The map is read under the lock; messages
+// are built and sent after it is released.
+#include <ros/ros.h>
+#include <tf2/exceptions.h>
+
+#include <boost/make_shared.hpp>
+#include <chrono>
+
+#include "mapping_ros_impl.h"
+
+namespace wavog_ros {
+
+void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const ros::Time now = ros::Time::now();
+  const RosParams& rp = config_.ros;
+
+  // Window centre: the robot, from tf (latest), outside the lock. Without it nothing is published
+  // but ~status.
+  double cx = 0.0, cy = 0.0;
+  bool window_ok = true;
+  if (rp.publish_window > 0.0) {
+    try {
+      const auto t = buffer_->lookupTransform(rp.map_frame, rp.base_frame, ros::Time(0));
+      cx = t.transform.translation.x;
+      cy = t.transform.translation.y;
+    } catch (const tf2::TransformException& e) {
+      window_ok = false;
+      ROS_WARN_THROTTLE(kWarnPeriod,
+                        "%s: no pose of '%s' for publish_window, maps not published: %s",
+                        pnh_.getNamespace().c_str(), rp.base_frame.c_str(), e.what());
+    }
+  }
+
+  Layers layers;
+  wavog_mapping::MapperStatus::Ptr status;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (window_ok) layers = publisher_->read(map_, rp, cx, cy);
+    status = statusLocked(now);
+  }
+  MapPublisher::publish(layers, rp.map_frame, now);
+  status_pub_.publish(status);
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  std::lock_guard<std::mutex> lock(mutex_);
+  publish_time_ = elapsed;
+}
+
+wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time& now) {
+  auto status = boost::make_shared<wavog_mapping::MapperStatus>();
+  const double period = (now - last_status_time_).toSec();
+  last_status_time_ = now;
+  status->header.stamp = now;
+  status->header.frame_id = config_.ros.map_frame;
+  for (const auto& in : inputs_) {
+    InputCounters& c = in->c;
+    c.rate = period > 0.0 ? static_cast<double>(c.received_in_period) / period : 0.0;
+    c.received_in_period = 0;
+    status->inputs.push_back(toInputStatus(c, in->topic, in->config.expected_rate));
+    status->scans_integrated += c[Counter::kIntegrated];
+    status->tf_failures += c.tfFailures();
+  }
+  status->clock_jumps = clock_jumps_;
+  last_mean_ =
+      integrate_count_ > 0 ? integrate_time_sum_ / static_cast<double>(integrate_count_) : 0.0;
+  last_max_ = integrate_time_max_;
+  status->integrate_time_mean = last_mean_;
+  status->integrate_time_max = last_max_;
+  integrate_time_sum_ = integrate_time_max_ = 0.0;
+  integrate_count_ = 0;
+  status->publish_time = publish_time_;
+  const wavog::MapStats ms = map_.stats();
+  status->blocks = ms.blocks;
+  status->nodes = ms.nodes;
+  status->bytes = ms.bytes;
+  return status;
+}
+
+void MappingRos::Impl::onUpdateTimer(const ros::TimerEvent&) {
+  if (!publisher_->updateWanted()) return;
+  const ros::Time now = ros::Time::now();
+  wavog::Raster raster;
+  wavog::CellBox full;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!publisher_->readUpdate(map_, &raster, &full)) return;
+  }
+  publisher_->publishUpdate(raster, full, config_.ros.map_frame, now);
+}
+
+}  // namespace wavog_ros

@@ -1,0 +1,166 @@
+// One scan through MappingRos, in the order it travels: onScan (counted, checked, time jumps) ->
+// the input's tf MessageFilter (fed by onTf; failures in onFilterFailure) -> onTransformable
+// (placeScan: tf at the first and last beam) -> integrateLocked (the core call, the counters and
+// the dirty region of map_updates).
+#include <ros/ros.h>
+#include <tf2/exceptions.h>
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+#include "mapping_ros_impl.h"
+#include "wavog_mapping/ros/conversions.h"
+
+namespace wavog_ros {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Stamps (or the clock) going back by more than this (s) are a time jump (e.g. a bag restart).
+constexpr double kTimeJumpThreshold = 1.0;
+/// Warning slot (Input::last_warn) shared by time jumps and motion fallbacks.
+constexpr std::size_t kOtherWarning = kNumDropReasons;
+
+/// Why the core refused a scan, as a drop reason.
+DropReason refusal(wavog::ScanStatus status) {
+  if (status == wavog::ScanStatus::kEmpty) return DropReason::kEmpty;
+  if (status == wavog::ScanStatus::kNoValidBeam) return DropReason::kNoValidBeam;
+  return DropReason::kBadGeometry;  // kBadGeometry, kBadPose
+}
+
+std::string refusalDetail(wavog::ScanStatus status) {
+  switch (refusal(status)) {
+    case DropReason::kEmpty:
+      return "no beams";
+    case DropReason::kNoValidBeam:
+      return "every beam is NaN, -inf or below range_min";
+    default:
+      return std::string("refused by the core: ") + wavog::toString(status);
+  }
+}
+
+}  // namespace
+
+void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan) {
+  if (in->freq) in->freq->tick();  // FrequencyStatus locks itself
+  const ros::Time now = ros::Time::now();
+  bool clear_tf = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    InputCounters& c = in->c;
+    ++c[Counter::kReceived];
+    ++c.received_in_period;
+    c.last_receipt = now;
+    // The clock jumping backwards (a bag restarted with --clock): the tf buffer holds the old
+    // future and would refuse every new scan, so clear it and go on.
+    if (!last_now_.isZero() && (last_now_ - now).toSec() > kTimeJumpThreshold) {
+      ++clock_jumps_;
+      clear_tf = true;
+    }
+    last_now_ = now;
+    // Stamps jumping backwards on one input (a bag restarted without --clock, a driver reset):
+    // counted and warned; such a scan is placed by tf if its stamp is still in the buffer, else
+    // dropped as too old.
+    const double back = (c.last_received_stamp - scan->header.stamp).toSec();
+    if (!c.last_received_stamp.isZero() && back > kTimeJumpThreshold) {
+      ++c[Counter::kTimeJumps];
+      warnLocked(in, kOtherWarning, "stamp jumped backwards by " + std::to_string(back) + " s");
+    }
+    c.last_received_stamp = scan->header.stamp;
+    DropReason reason{};
+    if (!checkScan(*scan, &reason)) {
+      std::ostringstream detail;
+      detail << "frame_id '" << scan->header.frame_id << "', " << scan->ranges.size()
+             << " ranges, angles [" << scan->angle_min << ", " << scan->angle_max << "] step "
+             << scan->angle_increment;
+      dropLocked(in, reason, detail.str());
+      return;
+    }
+  }
+  std::lock_guard<std::mutex> tf_lock(tf_mutex_);
+  if (clear_tf) {
+    ROS_WARN("%s: clock jumped backwards: tf buffer cleared", pnh_.getNamespace().c_str());
+    buffer_->clear();
+  }
+  in->filter->add(scan);
+}
+
+void MappingRos::Impl::onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static) {
+  std::lock_guard<std::mutex> tf_lock(tf_mutex_);
+  for (const auto& t : msg->transforms) {
+    try {
+      buffer_->setTransform(t, "default_authority", is_static);
+    } catch (const tf2::TransformException& e) {
+      ROS_WARN_THROTTLE(kWarnPeriod, "%s: transform refused by the tf buffer: %s",
+                        pnh_.getNamespace().c_str(), e.what());
+    }
+  }
+}
+
+void MappingRos::Impl::onFilterFailure(
+    Input* in, tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (reason == tf2_ros::filter_failure_reasons::OutTheBack) {
+    dropLocked(in, DropReason::kTfTooOld, "stamp older than the tf buffer");
+  } else if (reason == tf2_ros::filter_failure_reasons::EmptyFrameID) {
+    dropLocked(in, DropReason::kBadFrame, "empty frame_id");
+  } else {
+    dropLocked(in, DropReason::kTfUnavailable,
+               "no transform to '" + placement_.fixed_frame + "' (unknown frame or tf late)");
+  }
+}
+
+void MappingRos::Impl::onTransformable(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan) {
+  // tf lookups outside the lock: the buffer locks itself.
+  const ScanPlacement placement = placeScan(*buffer_, *scan, placement_);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!placement.placed()) {
+    dropLocked(in, DropReason::kTfUnavailable, placement.error);
+    return;
+  }
+  if (placement.motion_fallback) {
+    ++in->c[Counter::kMotionFallbacks];
+    warnLocked(in, kOtherWarning, "no tf at the end of the sweep: motion compensation skipped");
+  }
+  integrateLocked(in, *scan, placement);
+}
+
+void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& scan,
+                                       const ScanPlacement& placement) {
+  wavog::Pose2 pose;
+  const wavog::ScanView view = placement.placedView(scan, &compensator_, &pose);
+  const auto t0 = Clock::now();
+  const wavog::IntegrateStats st = map_.integrate(pose, view);
+  const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+  integrate_time_sum_ += dt;
+  integrate_time_max_ = std::max(integrate_time_max_, dt);
+  ++integrate_count_;
+  InputCounters& c = in->c;
+  c[Counter::kBeamsInvalid] += st.beams_invalid;
+  c[Counter::kBeamsNoReturn] += st.beams_no_return;
+  if (st.status != wavog::ScanStatus::kOk) {
+    dropLocked(in, refusal(st.status), refusalDetail(st.status));
+    return;
+  }
+  ++c[Counter::kIntegrated];
+  c.last_stamp = scan.header.stamp;
+  const double reach = wavog::scanReach(view, map_.params().sensor, map_.resolution());
+  publisher_->touched({pose.x - reach, pose.y - reach, pose.x + reach, pose.y + reach});
+}
+
+void MappingRos::Impl::dropLocked(Input* in, DropReason reason, const std::string& detail) {
+  const std::uint64_t n = ++in->c[droppedCounter(reason)];
+  warnLocked(in, static_cast<std::size_t>(reason),
+             "scan dropped (" + std::string(toString(reason)) + ", " + std::to_string(n) +
+                 " so far): " + detail);
+}
+
+void MappingRos::Impl::warnLocked(Input* in, std::size_t slot, const std::string& text) {
+  const ros::WallTime now = ros::WallTime::now();
+  if (!in->last_warn[slot].isZero() && (now - in->last_warn[slot]).toSec() < kWarnPeriod) return;
+  in->last_warn[slot] = now;
+  ROS_WARN("%s: %s", in->topic.c_str(), text.c_str());
+}
+
+}  // namespace wavog_ros

@@ -1,0 +1,65 @@
+// Scan placement (see scan_placement.h): tf lookups at the first and last beam, then the view the
+// core integrates (mirrored, motion-compensated).
+#include "wavog_mapping/ros/scan_placement.h"
+
+#include <tf2/exceptions.h>
+
+#include <cmath>
+
+#include "wavog_mapping/ros/conversions.h"
+
+namespace wavog_ros {
+
+ScanPlacement placeScan(const tf2::BufferCore& tf, const sensor_msgs::LaserScan& scan,
+                        const PlacementOptions& options) {
+  ScanPlacement p;
+  const std::string& frame = scan.header.frame_id;
+  // A laser that is the fixed frame cannot move in it: identity, nothing to compensate.
+  if (frame == options.fixed_frame) return p;
+  try {
+    p.start =
+        toPose2(tf.lookupTransform(options.fixed_frame, frame, scan.header.stamp).transform,
+                &p.mirrored);
+  } catch (const tf2::ExtrapolationException& e) {
+    p.failure = TfFailure::kExtrapolation;
+    p.error = e.what();
+    return p;
+  } catch (const tf2::TransformException& e) {
+    p.failure = TfFailure::kUnavailable;
+    p.error = e.what();
+    return p;
+  }
+  p.end = p.start;
+
+  const std::size_t n = scan.ranges.size();
+  if (!options.motion_compensation || n < 2 || !std::isfinite(scan.time_increment) ||
+      scan.time_increment == 0.0f) {
+    return p;
+  }
+  const double sweep = static_cast<double>(scan.time_increment) * static_cast<double>(n - 1);
+  try {
+    bool mirrored_end = false;
+    p.end = toPose2(
+        tf.lookupTransform(options.fixed_frame, frame, scan.header.stamp + ros::Duration(sweep))
+            .transform,
+        &mirrored_end);
+    p.compensate = true;
+  } catch (const tf2::TransformException&) {
+    p.end = p.start;
+    p.motion_fallback = true;
+  }
+  return p;
+}
+
+wavog::ScanView ScanPlacement::placedView(const sensor_msgs::LaserScan& scan,
+                                          wavog::MotionCompensator* compensator,
+                                          wavog::Pose2* pose) const {
+  wavog::ScanView view = toScanView(scan);
+  if (mirrored) mirrorView(&view);
+  *pose = start;
+  if (!compensate) return view;
+  *pose = wavog::interpolate(start, end, 0.5);
+  return compensator->compensate(view, start, end, *pose);
+}
+
+}  // namespace wavog_ros

@@ -1,0 +1,186 @@
+// The scan classifier alone, without a map, against the dense reference's cell-by-cell model:
+// every cell's class exact, every square's class conservative (E only if all its cells are E, U
+// only if all are U, FREE_OR_UNKNOWN only without O), the 4 x 4 groups exact, on seeded random
+// scans with every kind of bad beam (NaN, +-inf, 0, below range_min, beyond range_max).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "../../src/core/scan_classifier.h"
+#include "dense_reference.h"
+#include "test_support.h"
+#include "wavog_mapping/core/wavelet_map.h"
+
+namespace wavog_test {
+namespace {
+
+using wavog::CellClass;
+using wavog::detail::CellMasks;
+using wavog::detail::ScanClassifier;
+using wavog::detail::SquareInfo;
+
+// Counts of what the walk checked, so the test cannot pass by checking nothing.
+struct Seen {
+  std::array<std::size_t, 5> squares{};  // by CellClass
+  std::array<std::size_t, 3> cells{};    // U, E, O
+  std::size_t groups_4x4 = 0;
+};
+
+class Walk {
+ public:
+  Walk(const ScanClassifier& c, const ReferenceClassifier& r, Seen* seen)
+      : cls_(c), ref_(r), seen_(seen) {}
+
+  // Checks the square of side 2^l at (ix0, iy0) classified as `info`, then its sub-squares
+  // classified from it (as the integration does), down to its cells.
+  void square(int l, std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
+    ++seen_->squares[static_cast<std::size_t>(info.cls)];
+    expectConservative(l, ix0, iy0, info.cls);
+    if (info.cls == CellClass::kUnknown || ::testing::Test::HasFailure()) return;
+    if (l == 1) {
+      for (int q = 0; q < 4; ++q) {
+        const std::int64_t x = ix0 + (q & 1), y = iy0 + (q >> 1);
+        const CellClass want = ref_.cellClass(x, y);
+        ++seen_->cells[want == CellClass::kUnknown ? 0 : want == CellClass::kEmpty ? 1 : 2];
+        ASSERT_EQ(cls_.classifyCell(x, y, info), want) << "cell (" << x << ", " << y << ")";
+      }
+      return;
+    }
+    if (l == 2 && ScanClassifier::fewSectors(info)) expect4x4(ix0, iy0, info);
+    const std::int64_t half = std::int64_t{1} << (l - 1);
+    for (int q = 0; q < 4; ++q) {
+      const std::int64_t cx = ix0 + ((q & 1) ? half : 0), cy = iy0 + ((q & 2) ? half : 0);
+      square(l - 1, cx, cy, cls_.classifySquare(l - 1, cx, cy, info));
+    }
+  }
+
+ private:
+  void expectConservative(int l, std::int64_t ix0, std::int64_t iy0, CellClass cls) {
+    const std::int64_t size = std::int64_t{1} << l;
+    for (std::int64_t y = iy0; y < iy0 + size; ++y) {
+      for (std::int64_t x = ix0; x < ix0 + size; ++x) {
+        const CellClass c = ref_.cellClass(x, y);
+        const bool ok = cls == CellClass::kMixed ||
+                        (cls == CellClass::kEmpty && c == CellClass::kEmpty) ||
+                        (cls == CellClass::kUnknown && c == CellClass::kUnknown) ||
+                        (cls == CellClass::kFreeOrUnknown && c != CellClass::kOccupied);
+        ASSERT_TRUE(ok) << "square l=" << l << " at (" << ix0 << ", " << iy0 << ") class "
+                        << static_cast<int>(cls) << " holds cell (" << x << ", " << y
+                        << ") of class " << static_cast<int>(c);
+      }
+    }
+  }
+
+  void expect4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
+    ++seen_->groups_4x4;
+    const CellMasks m = cls_.classify4x4(ix0, iy0, info);
+    for (unsigned i = 0; i < 16; ++i) {
+      const std::int64_t x = ix0 + (i & 3), y = iy0 + (i >> 2);
+      const CellClass want = ref_.cellClass(x, y);
+      const CellClass got = ((m.e >> i) & 1u)   ? CellClass::kEmpty
+                            : ((m.o >> i) & 1u) ? CellClass::kOccupied
+                                                : CellClass::kUnknown;
+      ASSERT_FALSE(((m.e >> i) & 1u) && ((m.o >> i) & 1u)) << "cell both E and O";
+      ASSERT_EQ(got, want) << "4x4 at (" << ix0 << ", " << iy0 << "), cell (" << x << ", " << y
+                           << ")";
+    }
+  }
+
+  const ScanClassifier& cls_;
+  const ReferenceClassifier& ref_;
+  Seen* seen_;
+};
+
+void checkScans(const wavog::MapParams& p, std::uint32_t seed, int count, Seen* seen) {
+  const double half = 8.0;
+  RandomScans scans(seed, half);
+  ScanClassifier cls;
+  ReferenceClassifier ref;
+  constexpr int kLevels = 5;
+  const std::int64_t size = std::int64_t{1} << kLevels;
+  for (int i = 0; i < count; ++i) {
+    const OwnedScan s = scans.next();
+    wavog::IntegrateStats st;
+    const wavog::ScanStatus status = cls.prepare(p, s.pose, s.view(), &st);
+    const bool ref_ok = ref.prepare(p, s.pose, s.view());
+    ASSERT_EQ(status == wavog::ScanStatus::kOk, ref_ok) << "scan " << i;
+    if (!ref_ok) continue;
+    ASSERT_EQ(st.beams_hit + st.beams_no_return + st.beams_invalid, s.ranges.size());
+    // Every square of side 2^kLevels within the scan's reach (plus one square of margin).
+    const double reach = ref.reach() + size * p.grid.resolution;
+    const auto lo_x =
+        static_cast<std::int64_t>(std::floor((s.pose.x - reach) / p.grid.resolution)) / size - 1;
+    const auto hi_x =
+        static_cast<std::int64_t>(std::floor((s.pose.x + reach) / p.grid.resolution)) / size + 1;
+    const auto lo_y =
+        static_cast<std::int64_t>(std::floor((s.pose.y - reach) / p.grid.resolution)) / size - 1;
+    const auto hi_y =
+        static_cast<std::int64_t>(std::floor((s.pose.y + reach) / p.grid.resolution)) / size + 1;
+    Walk walk(cls, ref, seen);
+    for (std::int64_t by = lo_y; by <= hi_y; ++by) {
+      for (std::int64_t bx = lo_x; bx <= hi_x; ++bx) {
+        walk.square(kLevels, bx * size, by * size,
+                    cls.classifySquare(kLevels, bx * size, by * size));
+        if (::testing::Test::HasFailure()) return;
+      }
+    }
+  }
+}
+
+void expectEveryClassSeen(const Seen& seen, const std::string& what) {
+  EXPECT_GT(seen.squares[static_cast<std::size_t>(CellClass::kUnknown)], 0u) << what;
+  EXPECT_GT(seen.squares[static_cast<std::size_t>(CellClass::kEmpty)], 0u) << what;
+  EXPECT_GT(seen.squares[static_cast<std::size_t>(CellClass::kMixed)], 0u) << what;
+  EXPECT_GT(seen.cells[0], 0u) << what;
+  EXPECT_GT(seen.cells[1], 0u) << what;
+  EXPECT_GT(seen.cells[2], 0u) << what;
+  EXPECT_GT(seen.groups_4x4, 0u) << what;
+}
+
+TEST(ScanClassifier, RandomScansMatchTheCellByCellReference) {
+  wavog::MapParams p;
+  p.grid.resolution = 0.1;
+  Seen seen;
+  checkScans(p, 77u, 120, &seen);
+  expectEveryClassSeen(seen, "default sensor model");
+}
+
+TEST(ScanClassifier, ClearingNoReturnsWideBandAndMaxRange) {
+  wavog::MapParams p;
+  p.grid.resolution = 0.1;
+  p.sensor.no_return_clear = 2.5;  // no-return beams clear free space: FREE_OR_UNKNOWN squares
+  p.sensor.band_width = 0.35;
+  p.sensor.max_range = 2.8;  // some returns beyond it count as no return
+  Seen seen;
+  checkScans(p, 4242u, 120, &seen);
+  expectEveryClassSeen(seen, "clearing");
+  EXPECT_GT(seen.squares[static_cast<std::size_t>(CellClass::kFreeOrUnknown)], 0u);
+}
+
+TEST(ScanClassifier, RefusedScansAgreeWithTheReference) {
+  wavog::MapParams p;
+  ScanClassifier cls;
+  ReferenceClassifier ref;
+  const float ranges[3] = {1.0f, std::nanf(""), 2.0f};
+  const float invalid[2] = {std::nanf(""), -1.0f};
+  const wavog::ScanView good{ranges, 3, 0.0, 0.1, 0.1, 5.0};
+  wavog::ScanView zero_inc = good;
+  zero_inc.angle_increment = 0.0;
+  const wavog::ScanView none_valid{invalid, 2, 0.0, 0.1, 0.1, 5.0};
+  const wavog::ScanView empty{ranges, 0, 0.0, 0.1, 0.1, 5.0};
+  wavog::IntegrateStats st;
+  EXPECT_EQ(cls.prepare(p, {0, 0, 0}, good, &st), wavog::ScanStatus::kOk);
+  EXPECT_EQ(cls.prepare(p, {0, 0, 0}, zero_inc, &st), wavog::ScanStatus::kBadGeometry);
+  EXPECT_EQ(cls.prepare(p, {0, 0, 0}, none_valid, &st), wavog::ScanStatus::kNoValidBeam);
+  EXPECT_EQ(cls.prepare(p, {0, 0, 0}, empty, &st), wavog::ScanStatus::kEmpty);
+  EXPECT_EQ(cls.prepare(p, {std::nan(""), 0, 0}, good, &st), wavog::ScanStatus::kBadPose);
+  EXPECT_TRUE(ref.prepare(p, {0, 0, 0}, good));
+  EXPECT_FALSE(ref.prepare(p, {0, 0, 0}, zero_inc));
+  EXPECT_FALSE(ref.prepare(p, {0, 0, 0}, none_valid));
+}
+
+}  // namespace
+}  // namespace wavog_test

@@ -1,0 +1,143 @@
+// Scan placement (scan_placement.h), no master: a tf2::BufferCore filled in the test. A robot
+// drives along x at 1 m/s with a laser mounted upside down 0.2 m ahead of base_link: the placement
+// finds the poses at the first and last beam, mirrors the view and re-bins the sweep, and the map
+// holds the short beam's hit where the mirrored laser saw it. Then every way a placement can fail
+// or fall back, and the fixed-frame shortcut.
+#include <gtest/gtest.h>
+#include <tf2/buffer_core.h>
+
+#include <cmath>
+#include <vector>
+
+#include "wavog_mapping/core/motion_compensation.h"
+#include "wavog_mapping/core/wavelet_map.h"
+#include "driving_laser.h"
+#include "wavog_mapping/ros/scan_placement.h"
+
+namespace {
+
+using namespace driving_laser;  // NOLINT(google-build-using-namespace): the scenario's names
+
+/// The drive's tf in a buffer.
+class DrivingTf : public tf2::BufferCore {
+ public:
+  DrivingTf() : tf2::BufferCore(ros::Duration(3600.0)) {
+    setTransform(mount("laser_down"), "test", true);
+    for (const auto& t : drive()) setTransform(t, "test", false);
+  }
+};
+
+sensor_msgs::LaserScan scanAt(double t) { return driving_laser::scanAt(t, "laser_down"); }
+sensor_msgs::LaserScan scanAt(double t, const std::string& frame) {
+  return driving_laser::scanAt(t, frame);
+}
+
+TEST(ScanPlacement, UpsideDownLaserOnAMovingRobotIsMirroredAndCompensated) {
+  const DrivingTf tf;
+  const wavog_ros::PlacementOptions options;  // fixed frame "map", compensation on
+  wavog::WaveletMap map(wavog::MapParams::defaultsFor(wavog::PolicyType::kForget));
+  wavog::MotionCompensator compensator;
+  double last_x = 0.0;
+  for (int i = 0; i < kScans; ++i) {
+    const double t = scanTime(i);
+    const sensor_msgs::LaserScan scan = scanAt(t);
+    const wavog_ros::ScanPlacement p = wavog_ros::placeScan(tf, scan, options);
+    ASSERT_TRUE(p.placed()) << p.error;
+    EXPECT_TRUE(p.mirrored);
+    EXPECT_TRUE(p.compensate);
+    EXPECT_FALSE(p.motion_fallback);
+    EXPECT_NEAR(p.start.x, kMount + kSpeed * t, 1e-9);
+    EXPECT_NEAR(p.end.x, kMount + kSpeed * (t + kSweep), 1e-9);
+    EXPECT_NEAR(p.start.y, 0.0, 1e-12);
+    EXPECT_NEAR(p.start.theta, 0.0, 1e-12);  // rolled, not turned: its x axis still points ahead
+    wavog::Pose2 pose;
+    const wavog::ScanView view = p.placedView(scan, &compensator, &pose);
+    EXPECT_NEAR(pose.x, kMount + kSpeed * (t + kSweep / 2), 1e-9);  // the middle of the sweep
+    EXPECT_DOUBLE_EQ(view.angle_min, -static_cast<double>(scan.angle_min));
+    EXPECT_DOUBLE_EQ(view.angle_increment, -static_cast<double>(scan.angle_increment));
+    EXPECT_NE(view.ranges, scan.ranges.data());  // re-binned into the compensator's buffer
+    EXPECT_EQ(map.integrate(pose, view).status, wavog::ScanStatus::kOk);
+    last_x = pose.x;
+  }
+  // The last scan's short beam hit the map at -45 deg from the laser (mirrored), not at +45 deg.
+  // With forgetting (gamma 0.3), one hit on a cell seen free before lifts it from about -2 to
+  // 0.7 * -2 + 0.3 * 3.5 = -0.35; its mirror image stays free.
+  const double c = std::cos(M_PI / 4);
+  EXPECT_GT(map.value(map.cellAt(last_x + c, -c)), -0.5f);
+  EXPECT_LT(map.value(map.cellAt(last_x + c, c)), -1.5f);
+}
+
+TEST(ScanPlacement, ScanInTheFixedFrameIsHeldAtTheOriginWithoutTf) {
+  const tf2::BufferCore empty;
+  wavog_ros::PlacementOptions options;
+  options.fixed_frame = "laser";
+  const sensor_msgs::LaserScan scan = scanAt(0.5, "laser");
+  const wavog_ros::ScanPlacement p = wavog_ros::placeScan(empty, scan, options);
+  ASSERT_TRUE(p.placed()) << p.error;
+  EXPECT_FALSE(p.compensate);
+  EXPECT_FALSE(p.motion_fallback);
+  EXPECT_FALSE(p.mirrored);
+  wavog::MotionCompensator compensator;
+  wavog::Pose2 pose{1.0, 2.0, 3.0};
+  const wavog::ScanView view = p.placedView(scan, &compensator, &pose);
+  EXPECT_EQ(pose.x, 0.0);
+  EXPECT_EQ(pose.y, 0.0);
+  EXPECT_EQ(pose.theta, 0.0);
+  EXPECT_EQ(view.ranges, scan.ranges.data());  // the message's own beams
+  EXPECT_DOUBLE_EQ(view.angle_min, static_cast<double>(scan.angle_min));
+}
+
+TEST(ScanPlacement, UnknownFrameIsUnavailable) {
+  const DrivingTf tf;
+  const wavog_ros::ScanPlacement p =
+      wavog_ros::placeScan(tf, scanAt(0.5, "nowhere"), wavog_ros::PlacementOptions{});
+  EXPECT_FALSE(p.placed());
+  EXPECT_EQ(p.failure, wavog_ros::TfFailure::kUnavailable);
+  EXPECT_NE(p.error.find("nowhere"), std::string::npos) << p.error;
+}
+
+TEST(ScanPlacement, StampOutsideTheTfIsExtrapolation) {
+  const DrivingTf tf;
+  for (const double t : {-5.0, kTfSeconds + 5.0}) {
+    const wavog_ros::ScanPlacement p =
+        wavog_ros::placeScan(tf, scanAt(t), wavog_ros::PlacementOptions{});
+    EXPECT_FALSE(p.placed()) << t;
+    EXPECT_EQ(p.failure, wavog_ros::TfFailure::kExtrapolation) << t;
+    EXPECT_FALSE(p.error.empty());
+  }
+}
+
+TEST(ScanPlacement, NoTfAtTheLastBeamPlacesTheScanUncompensated) {
+  const DrivingTf tf;
+  const double t = kTfSeconds - kSweep / 2;  // first beam inside tf, last beam after it
+  const sensor_msgs::LaserScan scan = scanAt(t);
+  const wavog_ros::ScanPlacement p = wavog_ros::placeScan(tf, scan, wavog_ros::PlacementOptions{});
+  ASSERT_TRUE(p.placed()) << p.error;
+  EXPECT_TRUE(p.motion_fallback);
+  EXPECT_FALSE(p.compensate);
+  wavog::MotionCompensator compensator;
+  wavog::Pose2 pose;
+  const wavog::ScanView view = p.placedView(scan, &compensator, &pose);
+  EXPECT_NEAR(pose.x, kMount + kSpeed * t, 1e-9);  // the first beam's pose
+  EXPECT_EQ(view.ranges, scan.ranges.data());
+  EXPECT_DOUBLE_EQ(view.angle_min, -static_cast<double>(scan.angle_min));  // still mirrored
+}
+
+TEST(ScanPlacement, CompensationOffOrUntimedBeamsUseTheStampOnly) {
+  const DrivingTf tf;
+  wavog_ros::PlacementOptions off;
+  off.motion_compensation = false;
+  sensor_msgs::LaserScan untimed = scanAt(0.5);
+  untimed.time_increment = 0.0f;
+  for (const auto& [scan, options] :
+       {std::make_pair(scanAt(0.5), off), std::make_pair(untimed, wavog_ros::PlacementOptions{})}) {
+    const wavog_ros::ScanPlacement p = wavog_ros::placeScan(tf, scan, options);
+    ASSERT_TRUE(p.placed()) << p.error;
+    EXPECT_FALSE(p.compensate);
+    EXPECT_FALSE(p.motion_fallback);
+    EXPECT_NEAR(p.start.x, kMount + kSpeed * 0.5, 1e-9);
+    EXPECT_EQ(p.end.x, p.start.x);
+  }
+}
+
+}  // namespace
