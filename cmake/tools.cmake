@@ -97,4 +97,3 @@ target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io CLI11::CLI11
                       nlohmann_json::nlohmann_json Threads::Threads)
 target_compile_options(wavog_paper PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_paper PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
-install(TARGETS wavog_paper RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
