@@ -14,9 +14,7 @@ if(TARGET wavog_ros AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/tools/offline.cpp
   target_link_libraries(wavog_offline PRIVATE wavog_tool_support wavog_ros ${catkin_LIBRARIES})
   target_compile_options(wavog_offline PRIVATE ${WAVOG_WARNINGS})
   set_target_properties(wavog_offline PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
-  install(TARGETS wavog_offline RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 endif()
-install(TARGETS wavog_log2bag RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # ---- Tests: plain gtest executables (built by `make`, unlike catkin_add_gtest) run by ctest ----
 find_package(GTest REQUIRED)
@@ -102,4 +100,3 @@ target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io wavog_tool_support 
                       nlohmann_json::nlohmann_json Threads::Threads)
 target_compile_options(wavog_paper PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_paper PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
-install(TARGETS wavog_paper RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

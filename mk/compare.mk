@@ -7,7 +7,7 @@
 BUILD_COMPARE ?= $(ROOT)/build-compare
 COMPARE_OUT ?= $(ROOT)/compare_output
 # OctoMap needs seconds per scan on 80 m scans, so the logs are thinned (every 12th fr079 scan,
-# every 14th csail scan) and the synthetic run has 2 steps of 4 scans; see docs/sections/compare.md.
+# every 14th csail scan) and the synthetic run has 2 steps of 4 scans; see docs/compare.md.
 COMPARE_ARGS ?= --stride fr079=12,csail=14 --synthetic-steps 2 --reps 5
 
 .PHONY: compare

@@ -2,8 +2,9 @@
 #   make tsan         ThreadSanitizer build of the node in $(BUILD_TSAN); runs the integration and
 #                     bad-input rostests against it (4 scan inputs, tf, timers on 4 threads).
 #                     roscpp-internal reports are suppressed (test/ros/tsan.supp). ~4 min on 2 cores.
-#   make rviz-check   installs rviz + Xvfb (separate from `make deps`), runs rviz/wavog.rviz under
-#                     Xvfb against the integration scene and writes $(RVIZ_SHOT).
+#   make rviz-check   installs rviz + Xvfb (separate from `make deps`), plays 40 s of the simulated
+#                     car park through launch/playback.launch (config/lms291_x4.yaml) with
+#                     rviz/wavog.rviz under Xvfb and writes $(RVIZ_SHOT). About 1 minute.
 BUILD_TSAN ?= $(ROOT)/build-tsan
 RVIZ_SHOT ?= $(ROOT)/build/rviz_screenshot.png
 ROS_ENV := export ROS_DISTRO=Debian ROS_MASTER_URI=$${ROS_MASTER_URI:-http://localhost:11311}

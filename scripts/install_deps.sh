@@ -17,6 +17,10 @@ PKGS=(
   nlohmann-json3-dev libcli11-dev python3-matplotlib python3-pil
   ros-message-generation ros-message-runtime
   libcli11-dev nlohmann-json3-dev python3-matplotlib python3-numpy
+  # What the README's commands use at run time: rosrun, rostopic / rosservice / dynparam on the
+  # mapper's topics (Python message modules), the install-space test's map check.
+  rosbash python3-rospy python3-rosservice python3-rosparam python3-nav-msgs python3-sensor-msgs
+  python3-map-msgs python3-std-srvs python3-diagnostic-msgs python3-geometry-msgs python3-std-msgs
 )
 # `install_deps.sh fuzz` (make fuzz): clang and its libFuzzer / sanitizer runtimes as well.
 if [ "${1:-}" = fuzz ]; then
