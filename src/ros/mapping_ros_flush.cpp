@@ -37,9 +37,10 @@ void MappingRos::Impl::onIdleTimer(const ros::WallTimerEvent&) {
     changed = changed_since_publish_;
   }
   if (!changed) return;
-  ROS_INFO("%s: no scan or tf for %.1f s: %zu waiting scan(s) integrated with the latest tf, "
-           "publishing the map",
-           pnh_.getNamespace().c_str(), idle, n);
+  ROS_INFO(
+      "%s: no scan or tf for %.1f s: %zu waiting scan(s) integrated with the latest tf, "
+      "publishing the map",
+      pnh_.getNamespace().c_str(), idle, n);
   publishAll();
 }
 
@@ -72,8 +73,8 @@ std::size_t MappingRos::Impl::flushPending() {
     } catch (const tf2::TransformException& e) {
       error = e.what();
     }
-    const ScanPlacement placement = error.empty() ? placeScan(*buffer_, *scan, options)
-                                                  : ScanPlacement();
+    const ScanPlacement placement =
+        error.empty() ? placeScan(*buffer_, *scan, options) : ScanPlacement();
     std::lock_guard<std::mutex> lock(mutex_);
     if (!error.empty() || !placement.placed()) {
       dropLocked(in, DropReason::kTfUnavailable,

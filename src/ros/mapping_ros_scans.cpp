@@ -147,7 +147,8 @@ void MappingRos::Impl::onTransformable(Input* in, const sensor_msgs::LaserScan::
 
 bool MappingRos::Impl::takePendingLocked(Input* in, const sensor_msgs::LaserScan* scan) {
   auto& p = in->pending;
-  const auto it = std::find_if(p.begin(), p.end(), [scan](const auto& s) { return s.get() == scan; });
+  const auto it =
+      std::find_if(p.begin(), p.end(), [scan](const auto& s) { return s.get() == scan; });
   if (it == p.end()) return false;
   p.erase(it);
   return true;

@@ -431,7 +431,8 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
     // Old bags carry frame ids with a leading '/', which tf2 rejects: strip it, saying so once per
     // topic as the node does (the bag's tf frames were stripped the same way).
     const std::string received = scan->header.frame_id;
-    if (wavog_ros::stripFrameSlash(&scan->header.frame_id) && slash_warned.insert(m.getTopic()).second) {
+    if (wavog_ros::stripFrameSlash(&scan->header.frame_id) &&
+        slash_warned.insert(m.getTopic()).second) {
       info.warnings.push_back(m.getTopic() + ": " + wavog_ros::frameSlashWarning(received));
     }
     const std::string& frame = scan->header.frame_id;

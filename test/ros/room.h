@@ -126,8 +126,7 @@ inline sensor_msgs::LaserScan::Ptr circleScan(const std::string& frame, const ro
   scan->range_max = 80.0f;
   for (int i = 0; i < kCircleBeams; ++i) {
     const double a = scan->angle_min + i * static_cast<double>(scan->angle_increment);
-    scan->ranges.push_back(
-        static_cast<float>(castRay(ox, oy, std::cos(a), std::sin(a)) - shrink));
+    scan->ranges.push_back(static_cast<float>(castRay(ox, oy, std::cos(a), std::sin(a)) - shrink));
   }
   return scan;
 }

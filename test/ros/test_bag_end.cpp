@@ -134,15 +134,15 @@ int main(int argc, char** argv) {
             g_map = m;
             g_map_receipt = ros::WallTime::now();
           }));
-  auto log_sub = nh.subscribe<rosgraph_msgs::Log>(
-      "/rosout", 100,
-      boost::function<void(const rosgraph_msgs::Log::ConstPtr&)>(
-          [](const rosgraph_msgs::Log::ConstPtr& l) {
-            if (l->msg.find("leading '/'") != std::string::npos) {
-              std::lock_guard<std::mutex> lock(g_mutex);
-              g_slash_warnings.push_back(l->msg);
-            }
-          }));
+  auto log_sub =
+      nh.subscribe<rosgraph_msgs::Log>("/rosout", 100,
+                                       boost::function<void(const rosgraph_msgs::Log::ConstPtr&)>(
+                                           [](const rosgraph_msgs::Log::ConstPtr& l) {
+                                             if (l->msg.find("leading '/'") != std::string::npos) {
+                                               std::lock_guard<std::mutex> lock(g_mutex);
+                                               g_slash_warnings.push_back(l->msg);
+                                             }
+                                           }));
   ros::AsyncSpinner spinner(2);
   spinner.start();
   const int result = RUN_ALL_TESTS();

@@ -6,11 +6,11 @@
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <mutex>
 #include <string>
-#include <unistd.h>
 
 #include "room.h"
 #include "wavog_mapping/MapperStatus.h"
@@ -60,7 +60,8 @@ int differences(const wavog::WaveletMap& a, const wavog::WaveletMap& b) {
 TEST(ReconfigurePolicy, MapFollowsOldThenNewPolicy) {
   ros::NodeHandle nh;
   // The node's configuration as it started (the server mirrors later changes to these keys).
-  const wavog_ros::Config config = wavog_ros::loadConfig(ros::NodeHandle("/wavog_mapping"), nullptr);
+  const wavog_ros::Config config =
+      wavog_ros::loadConfig(ros::NodeHandle("/wavog_mapping"), nullptr);
   ASSERT_EQ(config.map.policy.type, wavog::PolicyType::kForget);
   auto pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 20);
   room::waitForSubscribers(pub, 1, 20.0);
@@ -141,8 +142,8 @@ int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_reconfigure_policy");
   ros::NodeHandle nh;
-  auto sub = room::keepLatest<wavog_mapping::MapperStatus>(nh, "wavog_mapping/status", 10,
-                                                           &g_mutex, &g_status);
+  auto sub = room::keepLatest<wavog_mapping::MapperStatus>(nh, "wavog_mapping/status", 10, &g_mutex,
+                                                           &g_status);
   ros::AsyncSpinner spinner(1);
   spinner.start();
   const int result = RUN_ALL_TESTS();
