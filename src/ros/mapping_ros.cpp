@@ -3,6 +3,7 @@
 // they lead to live in the files named in mapping_ros_impl.h.
 #include "wavog_mapping/ros/mapping_ros.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "mapping_ros_impl.h"
@@ -55,6 +56,7 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   reset_srv_ = pnh_.advertiseService("reset", &Impl::onReset, this);
   clear_srv_ = pnh_.advertiseService("clear_region", &Impl::onClearRegion, this);
   save_srv_ = pnh_.advertiseService("save_map", &Impl::onSaveMap, this);
+  flush_srv_ = pnh_.advertiseService("flush", &Impl::onFlush, this);
   startReconfigure();
   startTimers();
 
@@ -69,6 +71,7 @@ MappingRos::Impl::~Impl() {
   publish_timer_.stop();
   update_timer_.stop();
   diag_timer_.stop();
+  idle_timer_.stop();
   tf_sub_.shutdown();
   tf_static_sub_.shutdown();
   for (auto& in : inputs_) in->sub.shutdown();
@@ -106,8 +109,8 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
       [this, raw](const LaserScan::ConstPtr& scan) { onTransformable(raw, scan); }));
   in->filter->registerFailureCallback(
       boost::function<void(const LaserScan::ConstPtr&, FailureReason)>(
-          [this, raw](const LaserScan::ConstPtr&, FailureReason reason) {
-            onFilterFailure(raw, reason);
+          [this, raw](const LaserScan::ConstPtr& scan, FailureReason reason) {
+            onFilterFailure(raw, scan, reason);
           }));
   in->sub = nh_.subscribe<LaserScan>(
       ic.topic, kSubscriberQueue,
@@ -129,14 +132,11 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
 }
 
 void MappingRos::Impl::startReconfigure() {
-  // dynamic_reconfigure starts from the loaded configuration (not from the .cfg defaults, which
-  // are only the "forget" policy's).
-  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<wavog_mapping::MappingConfig>>(
-      reconfigure_mutex_, pnh_);
-  wavog_mapping::MappingConfig rc = toReconfigure(config_);
-  reconfigure_->updateConfig(rc);
-  reconfigure_->setCallback(
-      [this](wavog_mapping::MappingConfig& c, std::uint32_t level) { onReconfigure(c, level); });
+  // The server starts from the loaded configuration (not from the .cfg defaults, which are only
+  // the "forget" policy's).
+  reconfigure_ = std::make_unique<ReconfigureServer>(
+      pnh_, toReconfigure(config_),
+      [this](const wavog_mapping::MappingConfig& rc) { return onReconfigure(rc); });
 }
 
 void MappingRos::Impl::startTimers() {
@@ -150,29 +150,33 @@ void MappingRos::Impl::startTimers() {
   }
   diag_timer_ = nh_.createTimer(ros::Duration(kDiagnosticsPeriod),
                                 [this](const ros::TimerEvent&) { updater_->update(); });
+  if (rp.idle_timeout > 0.0) {
+    // Wall time: with use_sim_time the clock stops with the bag, and ROS timers with it.
+    noteActivity();
+    idle_timer_ = nh_.createWallTimer(ros::WallDuration(std::min(0.25, rp.idle_timeout / 4.0)),
+                                      &Impl::onIdleTimer, this);
+  }
 }
 
-void MappingRos::Impl::onReconfigure(wavog_mapping::MappingConfig& rc, std::uint32_t) {
+std::vector<std::string> MappingRos::Impl::onReconfigure(const wavog_mapping::MappingConfig& rc) {
   // The timer is re-armed after the lock is released (roscpp's timer manager has locks of its own).
   double new_period = 0.0;
+  std::vector<std::string> errors;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<std::string> errors;
     const Config next = withReconfigure(config_, rc, &errors);
     if (errors.empty()) {
       try {
-        map_.setPolicy(next.map.policy, next.map.sensor);
+        map_.setPolicy(next.map.policy, next.map.sensor);  // applies pending forgetting first
       } catch (const std::invalid_argument& e) {
         errors.emplace_back(e.what());
       }
     }
-    if (!errors.empty()) {
-      std::string text;
-      for (const auto& e : errors) text += "\n  " + e;
-      ROS_ERROR("%s: reconfiguration refused, keeping the previous values:%s",
-                pnh_.getNamespace().c_str(), text.c_str());
-      rc = toReconfigure(config_);  // handed back to the server (and its clients)
-      return;
+    if (!errors.empty()) return errors;  // the server logs them and answers the values in force
+    if (next.map.policy.type != config_.map.policy.type ||
+        next.map.policy.init != config_.map.policy.init) {
+      ROS_INFO("%s: policy %s, init %s from now on", pnh_.getNamespace().c_str(),
+               wavog::toString(next.map.policy.type), wavog::toString(next.map.policy.init));
     }
     if (next.ros.publish_rate != config_.ros.publish_rate) new_period = 1.0 / next.ros.publish_rate;
     // Only the run-time fields: the others (frames, ...) are read without the lock.
@@ -182,6 +186,7 @@ void MappingRos::Impl::onReconfigure(wavog_mapping::MappingConfig& rc, std::uint
     publisher_->advertiseScales(next.ros.publish_scales);
   }
   if (new_period > 0.0) publish_timer_.setPeriod(ros::Duration(new_period));
+  return errors;
 }
 
 MappingRos::MappingRos(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)

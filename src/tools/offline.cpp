@@ -36,6 +36,7 @@
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
 #include "wavog_mapping/io/image_io.h"
+#include "wavog_mapping/io/map_files.h"
 #include "wavog_mapping/ros/config.h"
 #include "wavog_mapping/ros/conversions.h"
 #include "wavog_mapping/ros/scan_placement.h"
@@ -46,7 +47,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
 
-constexpr int kCropMargin = 2;           // unknown cells kept around the known part of a picture
 constexpr double kTfCacheMargin = 60.0;  // s added to the bag's duration for the tf buffer
 
 struct Options {
@@ -365,6 +365,7 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   Session& s = **session;
   std::string first_tf_error;
   std::set<std::string> scan_frames;
+  std::set<std::string> slash_warned;  // topics whose frame_id had a leading '/'
   wavog::MotionCompensator compensator;
   wavog_ros::PlacementOptions placement_options;
   placement_options.fixed_frame = info.fixed_frame;
@@ -376,9 +377,13 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
       s.skip("not_a_laserscan");
       continue;
     }
-    // Old bags carry frame ids with a leading '/', which tf2 rejects: strip it (the bag's tf
-    // frames were stripped the same way).
-    scan->header.frame_id = wavog_tools::stripSlash(scan->header.frame_id);
+    // Old bags carry frame ids with a leading '/', which tf2 rejects: strip it, saying so once per
+    // topic as the node does (the bag's tf frames were stripped the same way).
+    const std::string received = scan->header.frame_id;
+    if (wavog_ros::stripFrameSlash(&scan->header.frame_id) &&
+        slash_warned.insert(m.getTopic()).second) {
+      info.warnings.push_back(m.getTopic() + ": " + wavog_ros::frameSlashWarning(received));
+    }
     const std::string& frame = scan->header.frame_id;
     scan_frames.insert(frame);
     wavog_ros::DropReason reason = wavog_ros::DropReason::kEmpty;
@@ -459,43 +464,6 @@ InputInfo runCarmen(const Options& o, const wavog_ros::Config& config,
   return info;
 }
 
-/// The raster cropped to its known cells plus a margin (the whole raster if nothing is known).
-wavog::Raster cropToKnown(const wavog::Raster& r) {
-  const std::int64_t w = r.box.width();
-  const std::int64_t h = r.box.height();
-  std::int64_t x0 = w, y0 = h, x1 = -1, y1 = -1;
-  for (std::int64_t y = 0; y < h; ++y) {
-    for (std::int64_t x = 0; x < w; ++x) {
-      if (r.known[static_cast<std::size_t>(y * w + x)]) {
-        x0 = std::min(x0, x);
-        x1 = std::max(x1, x);
-        y0 = std::min(y0, y);
-        y1 = std::max(y1, y);
-      }
-    }
-  }
-  if (x1 < 0) return r;
-  x0 = std::max<std::int64_t>(0, x0 - kCropMargin);
-  y0 = std::max<std::int64_t>(0, y0 - kCropMargin);
-  x1 = std::min<std::int64_t>(w - 1, x1 + kCropMargin);
-  y1 = std::min<std::int64_t>(h - 1, y1 + kCropMargin);
-  wavog::Raster c = r;
-  c.box = wavog::CellBox{r.box.min_x + x0, r.box.min_y + y0, r.box.min_x + x1 + 1,
-                         r.box.min_y + y1 + 1};
-  const std::int64_t cw = c.box.width();
-  c.log_odds.assign(static_cast<std::size_t>(cw * c.box.height()), 0.0f);
-  c.known.assign(c.log_odds.size(), 0);
-  for (std::int64_t y = y0; y <= y1; ++y) {
-    const std::size_t src = static_cast<std::size_t>(y * w + x0);
-    const std::size_t dst = static_cast<std::size_t>((y - y0) * cw);
-    std::copy_n(r.log_odds.begin() + static_cast<std::ptrdiff_t>(src), cw,
-                c.log_odds.begin() + static_cast<std::ptrdiff_t>(dst));
-    std::copy_n(r.known.begin() + static_cast<std::ptrdiff_t>(src), cw,
-                c.known.begin() + static_cast<std::ptrdiff_t>(dst));
-  }
-  return c;
-}
-
 /// Per scale: a PNG and a map_server map, cropped to the observed part; their entries of
 /// summary.json's "scales".
 Json writeScales(const Options& o, const wavog_ros::Config& config, Session* session) {
@@ -505,8 +473,8 @@ Json writeScales(const Options& o, const wavog_ros::Config& config, Session* ses
     wavog::CellBox box;
     if (!map->bounds(scale, &box)) break;
     const wavog::Raster raster =
-        cropToKnown(map->exportScale(scale, box, config.ros.scale_aggregation));
-    const std::string base = "map_s" + std::to_string(scale);
+        wavog::cropToKnown(map->exportScale(scale, box, config.ros.scale_aggregation));
+    const std::string base = wavog::scaleFileBase("map", scale);  // as ~save_map names them
     wavog::writePng((fs::path(o.out) / (base + ".png")).string(), wavog::renderRgb(raster));
     wavog::writeMapServerMap((fs::path(o.out) / base).string(), raster);
     scales.push_back({{"scale", scale},

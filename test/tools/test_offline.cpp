@@ -262,6 +262,10 @@ TEST(Offline, LaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) {
 
   r = run(WAVOG_OFFLINE, "--no-progress --fixed-frame laser -o " + out + " " + bag);
   ASSERT_EQ(r.status, 0) << r.err;
+  // The '/laser' frame id is stripped, and said so once (as the node does), not once per scan.
+  const std::size_t said = r.err.find("frame_id '/laser' has a leading '/'");
+  ASSERT_NE(said, std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("frame_id '/laser'", said + 1), std::string::npos) << r.err;
   // Count the bag's invalid readings: zeros (Hokuyo error codes) and those below range_min.
   std::uint64_t invalid = 0;
   std::uint64_t zeros = 0;
