@@ -8,7 +8,7 @@ PKGS=(
   build-essential cmake pkg-config zlib1g-dev libeigen3-dev libgtest-dev libgmock-dev
   libbenchmark-dev libpng-dev liboctomap-dev
   ros-base-dev catkin libroscpp-dev libnodelet-dev pluginlib-dev
-  libtf2-ros-dev libtf2-eigen-dev liblaser-geometry-dev libdiagnostic-updater-dev
+  libtf2-ros-dev liblaser-geometry-dev libdiagnostic-updater-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libsensor-msgs-dev libnav-msgs-dev libstd-srvs-dev libmap-msgs-dev libgeometry-msgs-dev
   librosbag-dev librosbag-storage-dev python3-rosbag python3-rostest python3-roslaunch
