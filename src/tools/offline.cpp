@@ -61,6 +61,7 @@ struct Options {
   double snapshot_every = 0.0;
   bool progress = true;
   bool quiet = false;
+  int threads = -1;  // -1: the YAML's num_threads
 };
 
 void usage(std::FILE* out) {
@@ -84,6 +85,8 @@ void usage(std::FILE* out) {
       "                          frame to map a bag without tf with the laser held fixed\n"
       "  --snapshot-every S      also write snapshots/t<seconds>_s<scale>.png every S s of log "
       "time\n"
+      "  --threads N             threads updating one scan's blocks (num_threads; 0: one per\n"
+      "                          core; the map is the same for every N)\n"
       "  --no-progress           no progress bar\n"
       "  --quiet                 only errors\n"
       "  -h, --help\n");
@@ -109,7 +112,8 @@ bool parseOptions(int argc, char** argv, Options* o) {
     kFixed,
     kSnapshot,
     kNoProgress,
-    kQuiet
+    kQuiet,
+    kThreads
   };
   const option longopts[] = {{"out", required_argument, nullptr, 'o'},
                              {"config", required_argument, nullptr, 'c'},
@@ -123,6 +127,7 @@ bool parseOptions(int argc, char** argv, Options* o) {
                              {"snapshot-every", required_argument, nullptr, kSnapshot},
                              {"no-progress", no_argument, nullptr, kNoProgress},
                              {"quiet", no_argument, nullptr, kQuiet},
+                             {"threads", required_argument, nullptr, kThreads},
                              {"help", no_argument, nullptr, 'h'},
                              {nullptr, 0, nullptr, 0}};
   int c = 0;
@@ -165,6 +170,9 @@ bool parseOptions(int argc, char** argv, Options* o) {
         o->quiet = true;
         o->progress = false;
         break;
+      case kThreads:
+        o->threads = static_cast<int>(wavog_tools::parseInteger("--threads", optarg, 0));
+        break;
       case 'h':
         usage(stdout);
         std::exit(0);
@@ -199,6 +207,7 @@ wavog_ros::Config loadConfig(const Options& o, std::vector<std::string>* unknown
   }
   if (!o.policy.empty()) root["policy"] = o.policy;
   if (o.resolution > 0.0) root["resolution"] = o.resolution;
+  if (o.threads >= 0) root["num_threads"] = o.threads;
   if (!o.aggregation.empty()) root["scale_aggregation"] = o.aggregation;
   try {
     return wavog_ros::configFromXmlRpc(root, unknown);
