@@ -53,6 +53,25 @@ int threadsFor(const MapParams& p) {
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
+// Updates the blocks jobs[i] for the indices i taken from `next` (shared by the threads of one
+// scan); node groups from `store`. Returns the nodes visited. The one place Integrator<P> is
+// made, so the hot code is compiled once per policy.
+template <PolicyType P>
+[[gnu::noinline]] std::uint64_t updateBlocks(WaveletMap::Impl& impl, detail::NodeStore& store,
+                                             const ScanClassifier& cls,
+                                             const detail::PolicyConsts& pc,
+                                             const std::vector<BlockJob>& jobs,
+                                             std::atomic<std::size_t>* next) {
+  detail::Integrator<P> integrator(impl, store, cls, pc);
+  for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < jobs.size();
+       i = next->fetch_add(1, std::memory_order_relaxed)) {
+    const BlockJob& j = jobs[i];
+    store.useSpare(&j.block->spare);
+    integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
+  }
+  return integrator.visited();
+}
+
 template <PolicyType P>
 std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, IntegrateStats* st) {
   const MapParams& p = impl.params;
@@ -89,14 +108,10 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, In
   // The chunk table grows here, whatever the thread count, so that its size does not depend on it.
   impl.pool.reserveFresh(jobs.size() * maxGroupsPerBlock(L));
   const int threads = std::min(threadsFor(p), static_cast<int>(jobs.size()));
+  std::atomic<std::size_t> next{0};
   if (threads <= 1) {
     detail::NodeStore store(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
-    detail::Integrator<P> integrator(impl, store, cls, pc);
-    for (const BlockJob& j : jobs) {
-      store.useSpare(&j.block->spare);
-      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
-    }
-    return visited + integrator.visited();
+    return visited + updateBlocks<P>(impl, store, cls, pc, jobs, &next);
   }
   if (!impl.workers || impl.workers->threads() != threadsFor(p)) {
     impl.workers = std::make_unique<detail::WorkerPool>(threadsFor(p));
@@ -108,21 +123,13 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, In
     std::size_t nodes = 0, groups = 0;
   };
   std::vector<Tally> tallies(static_cast<std::size_t>(impl.workers->threads()));
-  std::atomic<std::size_t> next{0};
-  const std::size_t active = static_cast<std::size_t>(threads);
+  const auto active = static_cast<std::size_t>(threads);
   impl.workers->run([&](int t) {
     const auto tu = static_cast<std::size_t>(t);
     if (tu >= active) return;
     Tally& tally = tallies[tu];
     detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
-    detail::Integrator<P> integrator(impl, store, cls, pc);
-    for (std::size_t i = next.fetch_add(1, std::memory_order_relaxed); i < jobs.size();
-         i = next.fetch_add(1, std::memory_order_relaxed)) {
-      const BlockJob& j = jobs[i];
-      store.useSpare(&j.block->spare);
-      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
-    }
-    tally.visited = integrator.visited();
+    tally.visited = updateBlocks<P>(impl, store, cls, pc, jobs, &next);
   });
   for (const Tally& tally : tallies) {
     visited += tally.visited;
