@@ -1,6 +1,12 @@
 # Offline tools (issue 4): wavog_log2bag (CARMEN log -> rosbag) and wavog_offline (bag or CARMEN
 # log -> maps, no roscore), with their tests (ctest label "tools"). Included when ROS is built.
 set(WAVOG_TOOLS_BIN_DIR ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+# The shared data the tool tests read: $WAVOG_DATA_DIR, else ../shared/data beside the repository.
+if(DEFINED ENV{WAVOG_DATA_DIR})
+  set(_wavog_data_dir $ENV{WAVOG_DATA_DIR})
+else()
+  get_filename_component(_wavog_data_dir ${CMAKE_CURRENT_SOURCE_DIR}/../shared/data ABSOLUTE)
+endif()
 
 add_executable(wavog_log2bag src/tools/log2bag.cpp)
 target_include_directories(wavog_log2bag SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -58,11 +64,6 @@ endif()
 # through launch/playback.launch into the node, compared with wavog_offline's map.
 if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
    AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/playback.test)
-  if(DEFINED ENV{WAVOG_DATA_DIR})
-    set(_wavog_data_dir $ENV{WAVOG_DATA_DIR})
-  else()
-    get_filename_component(_wavog_data_dir ${CMAKE_CURRENT_SOURCE_DIR}/../shared/data ABSOLUTE)
-  endif()
   if(EXISTS ${_wavog_data_dir}/fr079-corrected.log.gz)
     find_package(rostest REQUIRED)
     add_executable(test_playback test/tools/test_playback.cpp)
@@ -96,12 +97,7 @@ endif()
 # no tf), played through launch/playback.launch with fixed_frame_laser:=true.
 if(CATKIN_ENABLE_TESTING AND TARGET wavog_mapping_node
    AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/real_bag.test)
-  if(DEFINED ENV{WAVOG_DATA_DIR})
-    set(_wavog_real_bag_dir $ENV{WAVOG_DATA_DIR})
-  else()
-    get_filename_component(_wavog_real_bag_dir ${CMAKE_CURRENT_SOURCE_DIR}/../shared/data ABSOLUTE)
-  endif()
-  set(_wavog_real_bag ${_wavog_real_bag_dir}/laser_scan_matcher_demo.bag)
+  set(_wavog_real_bag ${_wavog_data_dir}/laser_scan_matcher_demo.bag)
   if(EXISTS ${_wavog_real_bag})
     find_package(rostest REQUIRED)
     add_executable(test_real_bag test/tools/test_real_bag.cpp)
