@@ -268,10 +268,10 @@ TEST(Limits, H1_BeamBeyondTheHardRangeLimitIsANoReturn) {
 
 // The hard limit caps no_return_clear as well, and bounds the cells and blocks a scan touches.
 TEST(Limits, HardRangeLimitCapsClearingAndBoundsTheWork) {
-  MapParams p = params(0.05, 2);  // small blocks: the block limit binds (512 blocks of 4 cells)
+  MapParams p = params(0.05, 2);  // small blocks: the block limit binds (256 blocks of 4 cells)
   p.sensor.no_return_clear = 1e6;
   const double hard = wavog::hardRangeLimit(p.grid);
-  EXPECT_DOUBLE_EQ(hard, 512.0 * 4.0 * 0.05);
+  EXPECT_DOUBLE_EQ(hard, 256.0 * 4.0 * 0.05);
   EXPECT_DOUBLE_EQ(wavog::hardRangeLimit(params(0.05, 9).grid), 65536.0 * 0.05);
   WaveletMap map(p);
   const std::vector<float> ranges = {std::numeric_limits<float>::infinity(), 150.0f};
@@ -279,7 +279,7 @@ TEST(Limits, HardRangeLimitCapsClearingAndBoundsTheWork) {
   const IntegrateStats st = map.integrate(Pose2{}, scan);
   ASSERT_EQ(st.status, ScanStatus::kOk);
   EXPECT_EQ(st.beams_no_return, 2u);
-  EXPECT_EQ(st.beams_beyond_limit, 1u);  // 150 m is beyond 102.4 m; +inf is a no return anyway
+  EXPECT_EQ(st.beams_beyond_limit, 1u);  // 150 m is beyond 51.2 m; +inf is a no return anyway
   EXPECT_TRUE(map.isObserved(map.cellAt(hard - 1.0, 0.0)));
   EXPECT_FALSE(map.isObserved(map.cellAt(hard + 1.0, 0.0)));
   const auto side = static_cast<std::int64_t>(2.0 * hard / 0.05) + 3;

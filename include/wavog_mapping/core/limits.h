@@ -33,8 +33,8 @@ std::int64_t clampedCellIndex(double cells);
 /// (3,276.8 m at 5 cm, 655.36 m at 1 cm).
 constexpr double kMaxRangeCells = 65536.0;
 /// Hard range limit in blocks (block side 2^block_levels cells), so that the block loop of one
-/// scan classifies at most (2 * kMaxRangeBlocks + 2)^2 blocks (binds below block_levels 7).
-constexpr double kMaxRangeBlocks = 512.0;
+/// scan classifies at most (2 * kMaxRangeBlocks + 2)^2 blocks (binds below block_levels 8).
+constexpr double kMaxRangeBlocks = 256.0;
 /// The hard range limit (m) of a grid: min(kMaxRangeCells cells, kMaxRangeBlocks blocks).
 double hardRangeLimit(const GridParams& grid);
 
