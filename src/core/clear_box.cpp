@@ -56,10 +56,9 @@ std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, doubl
   const double r = impl.params.grid.resolution;
   // Cells whose centre (i + 0.5) r lies in [min, max], clamped to one cell beyond the extent on
   // each side (no block lies there), so any bounds, +-inf included, convert exactly.
-  const ClearBox box{clampedCellIndex(std::ceil(min_x / r - 0.5)),
-                     clampedCellIndex(std::ceil(min_y / r - 0.5)),
-                     clampedCellIndex(std::floor(max_x / r - 0.5)),
-                     clampedCellIndex(std::floor(max_y / r - 0.5))};
+  const ClearBox box{
+      clampedCellIndex(std::ceil(min_x / r - 0.5)), clampedCellIndex(std::ceil(min_y / r - 0.5)),
+      clampedCellIndex(std::floor(max_x / r - 0.5)), clampedCellIndex(std::floor(max_y / r - 0.5))};
   if (box.x1 < box.x0 || box.y1 < box.y0) return 0;
   const int L = impl.levels;
   const std::int64_t size = std::int64_t{1} << L;

@@ -13,9 +13,11 @@ std::int64_t clampedCellIndex(double cells) {
   return static_cast<std::int64_t>(std::clamp(cells, -limit - 1.0, limit));
 }
 
-double hardRangeLimit(const GridParams& grid) {
+double hardRangeLimit(const GridParams& grid, std::size_t beams) {
   const double block_cells = std::ldexp(1.0, grid.block_levels);
-  return std::min(kMaxRangeCells, kMaxRangeBlocks * block_cells) * grid.resolution;
+  const double budget_cells =
+      kMaxScanBeamCells / static_cast<double>(std::max<std::size_t>(beams, 1));
+  return std::min({kMaxRangeCells, kMaxRangeBlocks * block_cells, budget_cells}) * grid.resolution;
 }
 
 std::uint64_t readoutCells(const CellBox& window) {

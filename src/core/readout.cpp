@@ -155,15 +155,14 @@ Raster WaveletMap::exportScale(int scale, const CellBox& window, Aggregation agg
   const std::uint64_t cells = readoutCells(window);
   if (cells > kMaxReadoutCells) {
     // Width and height as unsigned differences: exact for any window.
-    throw ReadoutTooLarge(
-        "read-out of " +
-        std::to_string(static_cast<std::uint64_t>(window.max_x) -
-                       static_cast<std::uint64_t>(window.min_x)) +
-        " x " +
-        std::to_string(static_cast<std::uint64_t>(window.max_y) -
-                       static_cast<std::uint64_t>(window.min_y)) +
-        " cells at scale " + std::to_string(r.scale) + " refused: more than " +
-        std::to_string(kMaxReadoutCells) + " cells (kMaxReadoutCells)");
+    throw ReadoutTooLarge("read-out of " +
+                          std::to_string(static_cast<std::uint64_t>(window.max_x) -
+                                         static_cast<std::uint64_t>(window.min_x)) +
+                          " x " +
+                          std::to_string(static_cast<std::uint64_t>(window.max_y) -
+                                         static_cast<std::uint64_t>(window.min_y)) +
+                          " cells at scale " + std::to_string(r.scale) + " refused: more than " +
+                          std::to_string(kMaxReadoutCells) + " cells (kMaxReadoutCells)");
   }
   const auto count = static_cast<std::size_t>(cells);
   r.log_odds.assign(count, static_cast<float>(impl.init));

@@ -88,10 +88,9 @@ bool ReferenceClassifier::prepare(const wavog::MapParams& p, const wavog::Pose2&
   seam_ = 0.5 * (amin_ + amax) - kPi;
   res_ = p.grid.resolution;
   // The hard range limit (limits.h) caps the range limit and the no-return clearing distance.
-  const double hard = wavog::hardRangeLimit(p.grid);
+  const double hard = wavog::hardRangeLimit(p.grid, scan.count);
   const double sensor_max = std::min(
-      p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max) : scan.range_max,
-      hard);
+      p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max) : scan.range_max, hard);
   const double clear = std::min(p.sensor.no_return_clear, hard);
   const double half_band = 0.5 * (p.sensor.band_width > 0 ? p.sensor.band_width : res_);
   const double inf = std::numeric_limits<double>::infinity();

@@ -109,10 +109,11 @@ TEST(Limits, F1_BlocksAtTheEdgesOfTheExtentLoadAndTheirReadOutIsRefused) {
     EXPECT_THROW(map.exportScale(s, box, Aggregation::kMean), wavog::ReadoutTooLarge);
   }
   // A window around one of the blocks reads out.
-  const wavog::Raster r = map.exportScale(0, CellBox{-wavog::kCellIndexLimit, -wavog::kCellIndexLimit,
-                                                     -wavog::kCellIndexLimit + 8,
-                                                     -wavog::kCellIndexLimit + 8},
-                                          Aggregation::kMean);
+  const wavog::Raster r =
+      map.exportScale(0,
+                      CellBox{-wavog::kCellIndexLimit, -wavog::kCellIndexLimit,
+                              -wavog::kCellIndexLimit + 8, -wavog::kCellIndexLimit + 8},
+                      Aggregation::kMean);
   ASSERT_EQ(r.known.size(), 64u);
   EXPECT_EQ(r.known[0], 1);
   EXPECT_EQ(r.known[63], 0);
@@ -270,9 +271,10 @@ TEST(Limits, H1_BeamBeyondTheHardRangeLimitIsANoReturn) {
 TEST(Limits, HardRangeLimitCapsClearingAndBoundsTheWork) {
   MapParams p = params(0.05, 2);  // small blocks: the block limit binds (256 blocks of 4 cells)
   p.sensor.no_return_clear = 1e6;
-  const double hard = wavog::hardRangeLimit(p.grid);
+  const double hard = wavog::hardRangeLimit(p.grid, 2);
   EXPECT_DOUBLE_EQ(hard, 256.0 * 4.0 * 0.05);
-  EXPECT_DOUBLE_EQ(wavog::hardRangeLimit(params(0.05, 9).grid), 65536.0 * 0.05);
+  EXPECT_DOUBLE_EQ(wavog::hardRangeLimit(params(0.05, 9).grid, 1), 65536.0 * 0.05);
+  EXPECT_DOUBLE_EQ(wavog::hardRangeLimit(params(0.05, 9).grid, 4096), 2048.0 * 0.05);
   WaveletMap map(p);
   const std::vector<float> ranges = {std::numeric_limits<float>::infinity(), 150.0f};
   const ScanView scan{ranges.data(), ranges.size(), 0.0, 0.001, 0.0, kInf};
@@ -289,15 +291,41 @@ TEST(Limits, HardRangeLimitCapsClearingAndBoundsTheWork) {
   EXPECT_LE(static_cast<double>(st.blocks_touched), blocks_side * blocks_side);
 }
 
+// The tree work of one scan is bounded by its beams times the hard range limit in cells: random
+// ranges up to the limit (the costliest scans measured, about 1.5 nodes per beam-cell) stay well
+// below 4 nodes per beam-cell of kMaxScanBeamCells.
+TEST(Limits, WorkOfTheCostliestScanIsBounded) {
+  const MapParams p = params(0.05, 9);
+  const std::size_t beams = 1081;
+  const double hard = wavog::hardRangeLimit(p.grid, beams);
+  EXPECT_NEAR(hard / 0.05, wavog::kMaxScanBeamCells / static_cast<double>(beams), 1e-6);
+  std::vector<float> ranges(beams);
+  std::uint64_t state = 12345;
+  for (float& z : ranges) {  // xorshift: uniform in (0, 0.999 hard)
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    z = static_cast<float>(0.999 * hard * static_cast<double>(state >> 11) * 0x1.0p-53) + 0.01f;
+  }
+  WaveletMap map(p);
+  const ScanView scan{ranges.data(), ranges.size(), -2.35, 4.7 / static_cast<double>(beams),
+                      0.0,           kInf};
+  const IntegrateStats st = map.integrate(Pose2{}, scan);
+  ASSERT_EQ(st.status, ScanStatus::kOk);
+  EXPECT_EQ(st.beams_hit, beams);
+  EXPECT_GT(st.nodes_visited, 1000000u);  // the case is costly indeed
+  EXPECT_LE(static_cast<double>(st.nodes_visited), 4.0 * wavog::kMaxScanBeamCells);
+}
+
 // Scratch buffers grown by one absurd scan are released; ordinary ones are kept for reuse.
 TEST(Limits, LargeScanScratchIsReleased) {
   const MapParams p = params(0.05, 9);
   wavog::detail::ScanClassifier cls;
   IntegrateStats st;
   std::vector<float> small(1000, 5.0f);
-  ASSERT_EQ(cls.prepare(p, Pose2{}, ScanView{small.data(), small.size(), -3.0, 0.006, 0.0, 30.0},
-                        &st),
-            ScanStatus::kOk);
+  ASSERT_EQ(
+      cls.prepare(p, Pose2{}, ScanView{small.data(), small.size(), -3.0, 0.006, 0.0, 30.0}, &st),
+      ScanStatus::kOk);
   cls.releaseIfLarge();
   EXPECT_GE(cls.scan().kind.capacity(), 1000u);
   std::vector<float> large(wavog::kScratchKeepBeams + 1, 5.0f);
@@ -311,12 +339,12 @@ TEST(Limits, LargeScanScratchIsReleased) {
   EXPECT_EQ(cls.scan().bnd_x.capacity(), 0u);
   // And the classifier still works afterwards.
   WaveletMap map(p);
-  EXPECT_EQ(map.integrate(Pose2{}, ScanView{large.data(), large.size(), -3.0, inc, 0.0, 30.0})
-                .status,
-            ScanStatus::kOk);
-  EXPECT_EQ(map.integrate(Pose2{}, ScanView{small.data(), small.size(), -3.0, 0.006, 0.0, 30.0})
-                .status,
-            ScanStatus::kOk);
+  EXPECT_EQ(
+      map.integrate(Pose2{}, ScanView{large.data(), large.size(), -3.0, inc, 0.0, 30.0}).status,
+      ScanStatus::kOk);
+  EXPECT_EQ(
+      map.integrate(Pose2{}, ScanView{small.data(), small.size(), -3.0, 0.006, 0.0, 30.0}).status,
+      ScanStatus::kOk);
 }
 
 // Motion compensation passes a scan with more beams than the core takes through untouched: it

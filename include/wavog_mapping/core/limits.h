@@ -28,15 +28,22 @@ inline bool inExtent(std::int64_t ix, std::int64_t iy) {
 /// The one float-to-index conversion of the core's entry points: never an overflowing cast.
 std::int64_t clampedCellIndex(double cells);
 
-/// Hard range limit in cells: a reading at or beyond kMaxRangeCells * resolution is a no return
-/// (REP 117), and no_return_clear is capped to it, whatever max_range and range_max say
-/// (3,276.8 m at 5 cm, 655.36 m at 1 cm).
+/// Hard range limit in cells: a reading at or beyond the hard range limit (hardRangeLimit()) is a
+/// no return (REP 117), and no_return_clear is capped to it, whatever max_range and range_max say.
+/// At most kMaxRangeCells cells (3,276.8 m at 5 cm, 655.36 m at 1 cm) ...
 constexpr double kMaxRangeCells = 65536.0;
-/// Hard range limit in blocks (block side 2^block_levels cells), so that the block loop of one
-/// scan classifies at most (2 * kMaxRangeBlocks + 2)^2 blocks (binds below block_levels 8).
+/// ... and at most kMaxRangeBlocks blocks (block side 2^block_levels cells), so that the block
+/// loop of one scan classifies at most (2 * kMaxRangeBlocks + 2)^2 blocks (binds below
+/// block_levels 8) ...
 constexpr double kMaxRangeBlocks = 256.0;
-/// The hard range limit (m) of a grid: min(kMaxRangeCells cells, kMaxRangeBlocks blocks).
-double hardRangeLimit(const GridParams& grid);
+/// ... and at most kMaxScanBeamCells / beams cells: the tree work of one scan follows its beams
+/// times their length in cells (measured worst case, random ranges up to the limit: about 1.7
+/// nodes visited per beam-cell), so this bounds it to about 1.4e7 nodes (2^23 beam-cells: 361
+/// beams reach 23,237 cells, 1,081 beams 7,760, 4,096 beams 2,048; 1,160 m / 388 m / 102 m at
+/// 5 cm).
+constexpr double kMaxScanBeamCells = 8388608.0;
+/// The hard range limit (m) of a scan of `beams` beams on `grid`: the smallest of the three above.
+double hardRangeLimit(const GridParams& grid, std::size_t beams);
 
 /// Largest |angle_min| (rad) a scan may have; beyond it, refused as kBadGeometry (bearings stay
 /// exact to 1e-14 rad below it; drivers send values in [-2 pi, 2 pi]).
@@ -57,9 +64,7 @@ constexpr std::uint64_t kMaxReadoutCells = std::uint64_t{1} << 26;
 /// UINT64_MAX.
 std::uint64_t readoutCells(const CellBox& window);
 /// True when exportScale accepts `window` (readoutCells(window) <= kMaxReadoutCells).
-inline bool readoutFits(const CellBox& window) {
-  return readoutCells(window) <= kMaxReadoutCells;
-}
+inline bool readoutFits(const CellBox& window) { return readoutCells(window) <= kMaxReadoutCells; }
 
 }  // namespace wavog
 

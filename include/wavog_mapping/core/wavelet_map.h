@@ -31,8 +31,8 @@ struct IntegrateStats {
   /// Readings below the scan's range limit but at or beyond the hard range limit
   /// (hardRangeLimit(), limits.h): taken as no returns, and counted in beams_no_return too.
   std::uint32_t beams_beyond_limit = 0;
-  std::uint64_t nodes_visited = 0;    ///< tree nodes and finest cells visited
-  std::uint32_t blocks_touched = 0;   ///< blocks classified as not U
+  std::uint64_t nodes_visited = 0;   ///< tree nodes and finest cells visited
+  std::uint32_t blocks_touched = 0;  ///< blocks classified as not U
   /// Finest cells within the scan's reach (the farthest E or O limit of its beams): every cell
   /// the scan changed lies in this box. Empty when status != kOk.
   CellBox touched;
