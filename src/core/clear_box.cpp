@@ -6,6 +6,7 @@
 
 #include "map_slot.h"
 #include "wavog_mapping/core/haar.h"
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
@@ -50,16 +51,16 @@ double clearNode(WaveletMap::Impl& impl, detail::NodeStore& store, Node& n, int 
 
 }  // namespace
 
-void WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y) {
-  if (!(min_x <= max_x && min_y <= max_y)) return;  // also rejects NaN
+std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y) {
+  if (!(min_x <= max_x && min_y <= max_y)) return 0;  // also rejects NaN
   Impl& impl = *impl_;
   const double r = impl.params.grid.resolution;
-  // Cells whose centre (i + 0.5) r lies in [min, max].
-  const ClearBox box{static_cast<std::int64_t>(std::ceil(min_x / r - 0.5)),
-                     static_cast<std::int64_t>(std::ceil(min_y / r - 0.5)),
-                     static_cast<std::int64_t>(std::floor(max_x / r - 0.5)),
-                     static_cast<std::int64_t>(std::floor(max_y / r - 0.5))};
-  if (box.x1 < box.x0 || box.y1 < box.y0) return;
+  // Cells whose centre (i + 0.5) r lies in [min, max], clamped to one cell beyond the extent on
+  // each side (no block lies there), so any bounds, +-inf included, convert exactly.
+  const ClearBox box{
+      clampedCellIndex(std::ceil(min_x / r - 0.5)), clampedCellIndex(std::ceil(min_y / r - 0.5)),
+      clampedCellIndex(std::floor(max_x / r - 0.5)), clampedCellIndex(std::floor(max_y / r - 0.5))};
+  if (box.x1 < box.x0 || box.y1 < box.y0) return 0;
   const int L = impl.levels;
   const std::int64_t size = std::int64_t{1} << L;
   std::vector<std::uint64_t> keys;
@@ -88,6 +89,7 @@ void WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y
         slot, slot.node(), [&](Node& m) { return clearNode(impl, store, m, L, x0, y0, s, box); });
     impl.dropIfEmpty(bx, by);
   }
+  return keys.size();
 }
 
 }  // namespace wavog

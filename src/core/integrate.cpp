@@ -23,7 +23,8 @@ using detail::ScanClassifier;
 // Numerical floor of the "E update changes nothing" test (log-odds).
 constexpr double kUnchangedFloor = 1e-9;
 
-// Box of finest cells [min, max) holding every cell within `reach` (m) of (px, py).
+// Box of finest cells [min, max) holding every cell within `reach` (m) of (px, py). prepare()
+// refuses a scan whose pose plus reach leaves the extent (limits.h), so the casts are exact.
 CellBox reachBox(double px, double py, double reach, double res) {
   CellBox box;
   box.min_x = static_cast<std::int64_t>(std::floor((px - reach) / res));
@@ -158,6 +159,7 @@ IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& s
   thread_local ScanClassifier classifier;
   st.status = classifier.prepare(impl_->params, sensor_pose, scan, &st);
   if (st.status != ScanStatus::kOk) {
+    classifier.releaseIfLarge();
     impl_->nodes_visited_last = 0;
     return st;
   }
@@ -165,6 +167,7 @@ IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& s
   st.touched = reachBox(ps.px, ps.py, ps.reach, ps.res);
   const auto policy = static_cast<std::size_t>(impl_->params.policy.type);
   st.nodes_visited = kIntegrateFor[policy](*impl_, classifier, &st);
+  classifier.releaseIfLarge();
   impl_->nodes_visited_last = st.nodes_visited;
   return st;
 }

@@ -229,6 +229,10 @@ void WaveletMap::load(const std::string& path) {
       const auto s = r.get<double>();
       const auto flags = r.get<std::uint8_t>();
       if (!std::isfinite(s) || flags > 7) throw std::runtime_error("bad block header");
+      if (!inExtent(detail::scaleUp(bx, fresh.levels), detail::scaleUp(by, fresh.levels))) {
+        throw std::runtime_error("block (" + std::to_string(bx) + ", " + std::to_string(by) +
+                                 ") outside the representable extent of +-2^30 cells");
+      }
       auto ins = fresh.blocks.try_emplace(detail::blockKey(bx, by));
       if (!ins.second) throw std::runtime_error("duplicate block");
       Block& b = ins.first->second;

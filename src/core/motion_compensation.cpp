@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
+
+#include "wavog_mapping/core/limits.h"
 
 namespace wavog {
 namespace {
@@ -16,13 +19,17 @@ enum Rank : signed char { kEmpty = -1, kInvalid = 0, kNoReturn = 1, kReturn = 2 
 }  // namespace
 
 double scanReach(const ScanView& scan, const SensorModelParams& sensor, double resolution) {
-  const double range_max =
+  // The core's hard range limit is at most kMaxRangeCells cells (limits.h): an upper bound.
+  const double hard = kMaxRangeCells * resolution;
+  const double given =
       sensor.max_range > 0.0 ? std::min(sensor.max_range, scan.range_max) : scan.range_max;
+  const double range_max = std::min(given, hard);
+  const double clear = std::min(sensor.no_return_clear, hard);
   double reach = 0.0;
   for (std::size_t i = 0; i < scan.count; ++i) {
     const double r = static_cast<double>(scan.ranges[i]);
     if (std::isnan(r) || r <= 0.0 || r < scan.range_min) continue;  // no information
-    reach = std::max(reach, r >= range_max ? sensor.no_return_clear : r);
+    reach = std::max(reach, r >= range_max ? clear : r);
   }
   if (reach <= 0.0) return 0.0;
   return reach + std::max(sensor.band_width, resolution) + resolution;
@@ -32,9 +39,20 @@ ScanView MotionCompensator::compensate(const ScanView& scan, const Pose2& start,
                                        const Pose2& reference) {
   dropped_ = 0;
   const double inc = scan.angle_increment;
-  if (scan.count == 0 || scan.ranges == nullptr || !std::isfinite(inc) || inc == 0.0) return scan;
+  // A scan the core refuses anyway (kBadGeometry, limits.h) is passed through untouched: its
+  // size bounds the work and the buffers below.
+  if (scan.count == 0 || scan.ranges == nullptr || !std::isfinite(inc) || inc == 0.0 ||
+      scan.count > kMaxBeams) {
+    return scan;
+  }
 
   const std::size_t n = scan.count;
+  if (n <= kScratchKeepBeams && ranges_.capacity() > kScratchKeepBeams) {
+    // Buffers grown by an earlier absurd scan are released by the next ordinary one (the view
+    // returned for the large scan pointed into them until now).
+    std::vector<float>().swap(ranges_);
+    std::vector<signed char>().swap(rank_);
+  }
   ranges_.assign(n, std::numeric_limits<float>::quiet_NaN());
   rank_.assign(n, kEmpty);
   // A scan whose beams cover the whole circle wraps around instead of dropping at its ends.

@@ -3,21 +3,26 @@
 #include "prepared_scan.h"
 
 #include <limits>
+#include <type_traits>
 
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
 namespace detail {
 namespace {
 
-// The reasons the core refuses a whole scan, or kOk.
+// The reasons the core refuses a whole scan, or kOk (the extent is checked once the reach is
+// known, in prepare()).
 ScanStatus checkScan(const Pose2& pose, const ScanView& scan) {
   if (scan.count == 0 || scan.ranges == nullptr) return ScanStatus::kEmpty;
   const double n_beams = static_cast<double>(scan.count);
-  if (!std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
-      scan.angle_increment == 0.0 || !std::isfinite(scan.range_min) || scan.range_min < 0.0 ||
-      !(scan.range_max > scan.range_min) || std::isnan(scan.range_max) ||
-      std::fabs(scan.angle_increment) * n_beams > kTwoPi + 1e-6 || scan.count > (1u << 24)) {
+  // The negated comparisons also refuse NaN.
+  if (!(std::fabs(scan.angle_min) <= kMaxAbsAngleMin) ||
+      !(std::fabs(scan.angle_increment) >= kMinAbsAngleIncrement) ||
+      !std::isfinite(scan.angle_increment) || !std::isfinite(scan.range_min) ||
+      scan.range_min < 0.0 || !(scan.range_max > scan.range_min) || std::isnan(scan.range_max) ||
+      std::fabs(scan.angle_increment) * n_beams > kTwoPi + 1e-6 || scan.count > kMaxBeams) {
     return ScanStatus::kBadGeometry;
   }
   if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
@@ -32,9 +37,20 @@ ScanStatus PreparedScan::prepare(const MapParams& params, const Pose2& pose, con
                                  IntegrateStats* st) {
   const ScanStatus status = checkScan(pose, scan);
   if (status != ScanStatus::kOk) return status;
-  setGeometry(pose, scan, params.grid.resolution);
+  const BeamLimits limits = beamLimits(params, scan);
+  // Every cell the scan may touch (hit cells, the reach box, the block loop) lies within
+  // max_reach of the pose: inside the extent, each of them is an exact int64 (no cast overflows)
+  // and a distinct 32-bit block key. Two cells of margin for the floors and the band rounding.
+  const double max_reach = std::max(limits.sensor_max + limits.half_band, limits.clear);
+  const double cell = params.grid.resolution;
+  const double extent = static_cast<double>(kCellIndexLimit) - 2.0;
+  if (!((std::fabs(pose.x) + max_reach) / cell < extent) ||
+      !((std::fabs(pose.y) + max_reach) / cell < extent)) {
+    return ScanStatus::kOutOfExtent;
+  }
+  setGeometry(pose, scan, cell);
   setBoundaries();
-  setBeams(params, scan, st);
+  setBeams(limits, scan, st);
   if (invalid_prefix[static_cast<std::size_t>(n)] == n) return ScanStatus::kNoValidBeam;
   std::sort(hits.begin(), hits.end());
   hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
@@ -89,14 +105,27 @@ void PreparedScan::setBoundaries() {
   }
 }
 
-void PreparedScan::setBeams(const MapParams& params, const ScanView& scan, IntegrateStats* st) {
-  const auto nu = static_cast<std::size_t>(n);
-  const double sensor_max = params.sensor.max_range > 0
-                                ? std::min(params.sensor.max_range, scan.range_max)
-                                : scan.range_max;
-  const double half_band =
+PreparedScan::BeamLimits PreparedScan::beamLimits(const MapParams& params, const ScanView& scan) {
+  // The hard limit caps range_max (+inf is allowed by REP 117) and no_return_clear, so one scan's
+  // reach, and with it the blocks and cells it may touch, is bounded (limits.h).
+  const double hard = hardRangeLimit(params.grid, scan.count);
+  const double given = params.sensor.max_range > 0
+                           ? std::min(params.sensor.max_range, scan.range_max)
+                           : scan.range_max;
+  BeamLimits limits;
+  limits.given = given;
+  limits.sensor_max = std::min(given, hard);
+  limits.clear = std::min(params.sensor.no_return_clear, hard);
+  limits.half_band =
       0.5 * (params.sensor.band_width > 0 ? params.sensor.band_width : params.grid.resolution);
-  const double clear = params.sensor.no_return_clear;
+  return limits;
+}
+
+void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, IntegrateStats* st) {
+  const auto nu = static_cast<std::size_t>(n);
+  const double sensor_max = limits.sensor_max;
+  const double half_band = limits.half_band;
+  const double clear = limits.clear;
   const double inf = std::numeric_limits<double>::infinity();
   kind.assign(nu, BeamKind::kInvalid);
   leaf.resize(nu);  // every element is written below
@@ -115,6 +144,7 @@ void PreparedScan::setBeams(const MapParams& params, const ScanView& scan, Integ
       ++st->beams_invalid;
     } else if (z >= sensor_max) {  // +inf and out-of-range readings: no return (REP 117)
       ++st->beams_no_return;
+      if (z < limits.given) ++st->beams_beyond_limit;  // a return but for the hard limit
       if (clear > 0) {
         kind[j] = BeamKind::kClear;
         ze = zu = clear;
@@ -161,6 +191,22 @@ void PreparedScan::buildTables() {
       max_u2[base + j] = std::max(max_u2[prev + j], max_u2[prev + j + half]);
     }
   }
+}
+
+void PreparedScan::releaseIfLarge() {
+  if (ranges_.capacity() <= kScratchKeepBeams) return;
+  const auto release = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
+  release(ranges_);
+  release(kind);
+  release(leaf);
+  release(hit_x);
+  release(hit_y);
+  release(hits);
+  release(invalid_prefix);
+  release(min_e2);
+  release(max_u2);
+  release(bnd_x);
+  release(bnd_y);
 }
 
 }  // namespace detail

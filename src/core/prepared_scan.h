@@ -36,6 +36,9 @@ struct PreparedScan {
   /// Beam counts go to `st`. Anything but kOk leaves the fields unusable.
   ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& scan,
                      IntegrateStats* st);
+  /// Releases the buffers when they were sized for more than kScratchKeepBeams beams (limits.h),
+  /// so one absurd scan does not keep its memory; ordinary scans keep reusing theirs.
+  void releaseIfLarge();
 
   double px = 0, py = 0, theta = 0;  ///< sensor pose (map frame)
   double amin = 0, inc = 0;          ///< beam j at bearing amin + j * inc (sensor frame), inc > 0
@@ -105,7 +108,14 @@ struct PreparedScan {
  private:
   void setGeometry(const Pose2& pose, const ScanView& scan, double res);
   void setBoundaries();
-  void setBeams(const MapParams& params, const ScanView& scan, IntegrateStats* st);
+  /// The range limits of one scan's beams (m): no return at or beyond sensor_max, the given
+  /// limit (min of range_max and max_range) capped, like the no-return clearing distance, by the
+  /// hard limit (limits.h).
+  struct BeamLimits {
+    double given = 0, sensor_max = 0, clear = 0, half_band = 0;
+  };
+  static BeamLimits beamLimits(const MapParams& params, const ScanView& scan);
+  void setBeams(const BeamLimits& limits, const ScanView& scan, IntegrateStats* st);
   void buildTables();
   int tableLevels();  // sizes the tables for n beams; returns their levels
 

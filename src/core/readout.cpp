@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "map_impl.h"
 #include "wavog_mapping/core/haar.h"
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
@@ -130,11 +132,14 @@ bool WaveletMap::bounds(int scale, CellBox* box) const {
 
 CellBox WaveletMap::boxAround(double min_x, double min_y, double max_x, double max_y,
                               int scale) const {
-  const double cell = std::ldexp(impl_->params.grid.resolution, scale);
-  return CellBox{static_cast<std::int64_t>(std::floor(min_x / cell)),
-                 static_cast<std::int64_t>(std::floor(min_y / cell)),
-                 static_cast<std::int64_t>(std::floor(max_x / cell)) + 1,
-                 static_cast<std::int64_t>(std::floor(max_y / cell)) + 1};
+  if (std::isnan(min_x) || std::isnan(min_y) || std::isnan(max_x) || std::isnan(max_y)) {
+    return CellBox{};
+  }
+  const double cell = std::ldexp(impl_->params.grid.resolution, std::clamp(scale, 0, 62));
+  return CellBox{clampedCellIndex(std::floor(min_x / cell)),
+                 clampedCellIndex(std::floor(min_y / cell)),
+                 clampedCellIndex(std::floor(max_x / cell)) + 1,
+                 clampedCellIndex(std::floor(max_y / cell)) + 1};
 }
 
 Raster WaveletMap::exportScale(int scale, const CellBox& window, Aggregation aggregation) const {
@@ -147,8 +152,19 @@ Raster WaveletMap::exportScale(int scale, const CellBox& window, Aggregation agg
     r.box = CellBox{};
     return r;
   }
-  const auto count =
-      static_cast<std::size_t>(window.width()) * static_cast<std::size_t>(window.height());
+  const std::uint64_t cells = readoutCells(window);
+  if (cells > kMaxReadoutCells) {
+    // Width and height as unsigned differences: exact for any window.
+    throw ReadoutTooLarge("read-out of " +
+                          std::to_string(static_cast<std::uint64_t>(window.max_x) -
+                                         static_cast<std::uint64_t>(window.min_x)) +
+                          " x " +
+                          std::to_string(static_cast<std::uint64_t>(window.max_y) -
+                                         static_cast<std::uint64_t>(window.min_y)) +
+                          " cells at scale " + std::to_string(r.scale) + " refused: more than " +
+                          std::to_string(kMaxReadoutCells) + " cells (kMaxReadoutCells)");
+  }
+  const auto count = static_cast<std::size_t>(cells);
   r.log_odds.assign(count, static_cast<float>(impl.init));
   r.known.assign(count, 0);
   RasterWriter writer(impl, &r, aggregation);

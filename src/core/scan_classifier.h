@@ -41,6 +41,8 @@ class ScanClassifier {
   ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& scan,
                      IntegrateStats* st);
   const PreparedScan& scan() const { return s_; }
+  /// Releases the per-scan buffers if one absurd scan grew them (PreparedScan::releaseIfLarge).
+  void releaseIfLarge() { s_.releaseIfLarge(); }
 
   /// Class of the square of side 2^l cells at cell (ix0, iy0).
   SquareInfo classifySquare(int l, std::int64_t ix0, std::int64_t iy0) const;

@@ -11,8 +11,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 const char* toString(ScanStatus status) {
   // In the order of the enumerators.
-  constexpr const char* kNames[] = {"ok", "empty_scan", "bad_geometry", "bad_pose",
-                                    "no_valid_beam"};
+  constexpr const char* kNames[] = {"ok",       "empty_scan",    "bad_geometry",
+                                    "bad_pose", "no_valid_beam", "out_of_extent"};
   const auto i = static_cast<std::size_t>(status);
   return i < sizeof(kNames) / sizeof(kNames[0]) ? kNames[i] : "unknown";
 }

@@ -24,8 +24,7 @@ double WaveletMap::resolution() const { return impl_->params.grid.resolution; }
 
 CellIndex WaveletMap::cellAt(double x, double y) const {
   const double r = impl_->params.grid.resolution;
-  return {static_cast<std::int64_t>(std::floor(x / r)),
-          static_cast<std::int64_t>(std::floor(y / r))};
+  return {clampedCellIndex(std::floor(x / r)), clampedCellIndex(std::floor(y / r))};
 }
 
 namespace {
@@ -33,6 +32,8 @@ namespace {
 // way, nothing written). Returns the cell's value and whether it was observed.
 std::pair<float, bool> lookup(const WaveletMap::Impl& impl, const CellIndex& cell) {
   const int levels = impl.levels;
+  // Outside the extent no block exists; a 32-bit block key of such a cell would alias one.
+  if (!inExtent(cell.x, cell.y)) return {static_cast<float>(impl.init), false};
   const Block* b =
       impl.findBlock(detail::floorShift(cell.x, levels), detail::floorShift(cell.y, levels));
   if (b == nullptr) return {static_cast<float>(impl.init), false};

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "wavog_mapping/core/limits.h"
+
 namespace wavog_test {
 
 using wavog::PolicyType;
@@ -63,8 +65,10 @@ double DenseReference::apply(const wavog::MapParams& p, bool occupied, double x)
 bool ReferenceClassifier::prepare(const wavog::MapParams& p, const wavog::Pose2& pose,
                                   const wavog::ScanView& scan) {
   // Scans the core refuses change nothing.
-  if (scan.count == 0 || !std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
-      scan.angle_increment == 0.0 || !std::isfinite(scan.range_min) || scan.range_min < 0 ||
+  if (scan.count == 0 || !(std::fabs(scan.angle_min) <= wavog::kMaxAbsAngleMin) ||
+      !std::isfinite(scan.angle_increment) ||
+      !(std::fabs(scan.angle_increment) >= wavog::kMinAbsAngleIncrement) ||
+      scan.count > wavog::kMaxBeams || !std::isfinite(scan.range_min) || scan.range_min < 0 ||
       !(scan.range_max > scan.range_min) ||
       std::fabs(scan.angle_increment) * static_cast<double>(scan.count) > 2 * kPi + 1e-6 ||
       !std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
@@ -83,8 +87,11 @@ bool ReferenceClassifier::prepare(const wavog::MapParams& p, const wavog::Pose2&
   const double amax = amin_ + inc_ * (static_cast<double>(n_) - 1.0);
   seam_ = 0.5 * (amin_ + amax) - kPi;
   res_ = p.grid.resolution;
-  const double sensor_max =
-      p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max) : scan.range_max;
+  // The hard range limit (limits.h) caps the range limit and the no-return clearing distance.
+  const double hard = wavog::hardRangeLimit(p.grid, scan.count);
+  const double sensor_max = std::min(
+      p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max) : scan.range_max, hard);
+  const double clear = std::min(p.sensor.no_return_clear, hard);
   const double half_band = 0.5 * (p.sensor.band_width > 0 ? p.sensor.band_width : res_);
   const double inf = std::numeric_limits<double>::infinity();
 
@@ -99,9 +106,9 @@ bool ReferenceClassifier::prepare(const wavog::MapParams& p, const wavog::Pose2&
     const double z = ranges[ju];
     if (std::isnan(z) || z == -inf || z <= 0 || z < scan.range_min) continue;
     if (z >= sensor_max) {
-      if (p.sensor.no_return_clear > 0) {
+      if (clear > 0) {
         kind_[ju] = 2;
-        ze_[ju] = zu_[ju] = p.sensor.no_return_clear;
+        ze_[ju] = zu_[ju] = clear;
         any_valid = true;
       }
       continue;

@@ -7,6 +7,7 @@
 #include <fuzzer/FuzzedDataProvider.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cstdint>
 #include <cstdio>
@@ -14,6 +15,9 @@
 #include <fstream>
 #include <limits>
 #include <string>
+
+#include "wavog_mapping/core/limits.h"
+#include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog_fuzz {
 
@@ -47,28 +51,34 @@ inline void writeFile(const std::string& path, const std::uint8_t* data, std::si
     }                                                                                   \
   } while (0)
 
-/// Guards that keep the harnesses off input classes with a known, reported core finding whose fix
-/// belongs to the core (issue 16, second pass). WAVOG_FUZZ_NO_GUARDS=1 in the environment lifts
-/// them all, to reproduce the findings: `WAVOG_FUZZ_NO_GUARDS=1 build-fuzz/fuzz/<harness> <input>`.
-inline bool guardsOn() {
-  static const bool on = [] {
-    const char* v = std::getenv("WAVOG_FUZZ_NO_GUARDS");
-    return v == nullptr || v[0] == '\0' || v[0] == '0';
-  }();
-  return on;
+/// Cells a harness reads out of one window at most (2^18: 1 MiB of floats; larger windows would
+/// mostly cost instrumented fill loops). A harness speed choice, not a core limit.
+constexpr std::int64_t kReadOutCells = std::int64_t{1} << 18;
+
+/// The window a harness reads out of `bounds` (which the core accepts, readoutFits): the bounds,
+/// or their lower corner when they hold more than kReadOutCells cells.
+inline wavog::CellBox readOutWindow(const wavog::CellBox& bounds) {
+  wavog::CellBox w = bounds;
+  if (static_cast<double>(w.width()) * static_cast<double>(w.height()) >
+      static_cast<double>(kReadOutCells)) {
+    w.max_x = w.min_x + std::min<std::int64_t>(w.width(), 512);
+    w.max_y = w.min_y + std::min<std::int64_t>(w.height(), kReadOutCells / (w.max_x - w.min_x));
+  }
+  return w;
 }
 
-/// TODO(hostile, #16): WaveletMap::exportScale allocates width x height raster cells with no
-/// bound. Blocks 2^32 block sides apart make the size product wrap to 0 and the writer stores
-/// through a null pointer (UBSan: "applying non-zero offset ... to null pointer" in
-/// RasterWriter::fill, readout.cpp); blocks 2^20 apart ask for 2^46 bytes (bad_alloc /
-/// length_error in a release build). Until the core bounds its read-out, windows above this many
-/// cells (1 MiB of floats; larger ones would mostly cost instrumented fill loops) are not read
-/// out. The limit is the harness's, not the core's: remove it with the fix.
-constexpr double kReadOutGuardCells = 1 << 18;
-inline bool readOutGuarded(std::int64_t width, std::int64_t height) {
-  return guardsOn() &&
-         static_cast<double>(width) * static_cast<double>(height) > kReadOutGuardCells;
+/// A read-out the core must refuse (more than kMaxReadoutCells cells): checks that exportScale
+/// throws ReadoutTooLarge.
+inline void expectReadOutRefused(const wavog::WaveletMap& map, int scale,
+                                 const wavog::CellBox& window) {
+  bool refused = false;
+  try {
+    (void)map.exportScale(scale, window, wavog::Aggregation::kMean);
+  } catch (const wavog::ReadoutTooLarge&) {
+    refused = true;
+  }
+  WAVOG_FUZZ_CHECK(refused, "scale %d: a window of %llu cells was read out", scale,
+                   static_cast<unsigned long long>(wavog::readoutCells(window)));
 }
 
 /// A double a broken driver or an attacker might send: one of the hostile constants (NaN, +-inf,

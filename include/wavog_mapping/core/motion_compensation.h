@@ -16,6 +16,8 @@ namespace wavog {
 /// Farthest distance (m) from the sensor at which `scan` can change the map under `sensor`: the
 /// longest return (plus the occupied band), or no_return_clear when a beam has no return. Used to
 /// bound the region a scan touched (e.g. for incremental map publication). 0 for an empty scan.
+/// Ranges and no_return_clear are capped at kMaxRangeCells * resolution (limits.h), an upper
+/// bound of the core's hard range limit.
 double scanReach(const ScanView& scan, const SensorModelParams& sensor, double resolution);
 
 /// Re-bins moving-sensor scans. Beam i is assumed to be measured at fraction i / (count - 1) of the
@@ -29,7 +31,9 @@ class MotionCompensator {
   /// reference frame), else an invalid value as measured (REP 117), else NaN (no information).
   /// Returns land outside the field of view are dropped (counted by droppedLast()); a full-circle
   /// scan wraps around. The view points into this object and stays valid until the next call.
-  /// A scan without beams or with a zero or non-finite angle_increment is returned unchanged.
+  /// A scan without beams, with a zero or non-finite angle_increment, or with more than kMaxBeams
+  /// beams (limits.h; the core refuses it) is returned unchanged. Buffers grown beyond
+  /// kScratchKeepBeams beams are released by the next smaller scan.
   ScanView compensate(const ScanView& scan, const Pose2& start, const Pose2& end,
                       const Pose2& reference);
 

@@ -72,9 +72,12 @@ enum class CellClass : std::uint8_t {
 enum class ScanStatus : std::uint8_t {
   kOk,
   kEmpty,        ///< no beams
-  kBadGeometry,  ///< angle_increment zero or non-finite, field of view > 2 pi, bad range limits
+  kBadGeometry,  ///< angle_min or angle_increment non-finite or absurd (limits.h), field of view
+                 ///< > 2 pi, more than kMaxBeams beams, bad range limits
   kBadPose,      ///< non-finite sensor pose
   kNoValidBeam,  ///< every beam is invalid: nothing to integrate (map unchanged)
+  kOutOfExtent,  ///< the sensor pose plus the scan's range limit (or no-return clearing
+                 ///< distance) leaves the representable extent (kCellIndexLimit, limits.h)
 };
 
 /// Human-readable name of a ScanStatus, for logs and counters.

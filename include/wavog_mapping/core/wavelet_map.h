@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/types.h"
 
@@ -31,8 +32,11 @@ struct IntegrateStats {
   std::uint32_t beams_hit = 0;        ///< beams with a return in [range_min, range_max)
   std::uint32_t beams_no_return = 0;  ///< +inf or >= range_max (REP 117)
   std::uint32_t beams_invalid = 0;    ///< NaN, -inf, <= 0, < range_min
-  std::uint64_t nodes_visited = 0;    ///< tree nodes and finest cells visited
-  std::uint32_t blocks_touched = 0;   ///< blocks classified as not U
+  /// Readings below the scan's range limit but at or beyond the hard range limit
+  /// (hardRangeLimit(), limits.h): taken as no returns, and counted in beams_no_return too.
+  std::uint32_t beams_beyond_limit = 0;
+  std::uint64_t nodes_visited = 0;   ///< tree nodes and finest cells visited
+  std::uint32_t blocks_touched = 0;  ///< blocks classified as not U
   /// Finest cells within the scan's reach (the farthest E or O limit of its beams): every cell
   /// the scan changed lies in this box. Empty when status != kOk.
   CellBox touched;
@@ -77,6 +81,13 @@ class MapIoError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// exportScale was asked for more than kMaxReadoutCells raster cells (limits.h); nothing was
+/// allocated. what() gives the window's size. Check readoutFits() first to avoid it.
+class ReadoutTooLarge : public std::length_error {
+ public:
+  using std::length_error::length_error;
+};
+
 class WaveletMap {
  public:
   /// Throws std::invalid_argument naming every invalid parameter.
@@ -91,7 +102,9 @@ class WaveletMap {
   double resolution() const;
 
   /// Integrates one scan taken from `sensor_pose` (map frame). Beams are classified per REP 117;
-  /// every cell in the field of view is updated at most once. Never throws.
+  /// every cell in the field of view is updated at most once. Readings at or beyond the hard
+  /// range limit (hardRangeLimit(), limits.h) are no returns; a pose whose reach leaves the
+  /// extent is refused (kOutOfExtent). Never throws.
   IntegrateStats integrate(const Pose2& sensor_pose, const ScanView& scan);
 
   /// Changes policy and sensor-model parameters at run time (grid and pruning stay). Pending lazy
@@ -99,24 +112,32 @@ class WaveletMap {
   void setPolicy(const PolicyParams& policy, const SensorModelParams& sensor);
 
   /// Log-odds of one finest cell (the prior if never observed) and whether it was observed.
+  /// Cells outside the extent (limits.h) are never observed.
   float value(const CellIndex& cell) const;
   bool isObserved(const CellIndex& cell) const;
-  /// Finest cell containing a map-frame point.
+  /// Finest cell containing a map-frame point; indices are clamped to one cell beyond the extent
+  /// (kCellIndexLimit), NaN to that cell too.
   CellIndex cellAt(double x, double y) const;
 
   /// Smallest box of scale-s cells holding every stored block; false when the map is empty.
+  /// It always lies inside the extent (limits.h) but may be too large to read out: check it with
+  /// readoutFits().
   bool bounds(int scale, CellBox* box) const;
-  /// Box of scale-s cells covering the metric rectangle [min, max] (map frame).
+  /// Box of scale-s cells covering the metric rectangle [min, max] (map frame), clamped to the
+  /// extent (kCellIndexLimit finest cells; NaN bounds give an empty box).
   CellBox boxAround(double min_x, double min_y, double max_x, double max_y, int scale) const;
   /// Dense read-out of `window` at scale s in [0, block_levels]. Cost follows the stored nodes
-  /// inside the window, not the whole map.
+  /// inside the window, not the whole map. Throws ReadoutTooLarge, allocating nothing, when the
+  /// window has more than kMaxReadoutCells cells (readoutFits(window) is false).
   Raster exportScale(int scale, const CellBox& window, Aggregation aggregation) const;
 
   /// Forgets everything: the whole map back to never observed.
   void reset();
   /// Every finest cell whose centre lies in [min_x, max_x] x [min_y, max_y] (map frame) goes back
-  /// to never observed.
-  void clearBox(double min_x, double min_y, double max_x, double max_y);
+  /// to never observed. Any bounds are taken (infinite ones clear to the end of the extent; NaN
+  /// or min > max clear nothing); the work follows the stored blocks. Returns the number of
+  /// stored blocks the box met (changed or removed); 0 when nothing was cleared.
+  std::size_t clearBox(double min_x, double min_y, double max_x, double max_y);
 
   /// Writes the map (versioned binary, CRC-32 checked) to `path` through a new temporary file in
   /// the same directory (created exclusively, never through a symlink), synced, then renamed over
@@ -124,8 +145,9 @@ class WaveletMap {
   void save(const std::string& path) const;
   /// Replaces the map by the one in `path`, a regular file (a directory, FIFO or device is refused
   /// at once, without blocking). A missing, truncated, corrupted or foreign file, one larger than
-  /// its header's block count allows, or one with another resolution or block size, throws
-  /// MapIoError naming the file and the reason, and leaves this map unchanged.
+  /// its header's block count allows, one with a block outside the extent (kCellIndexLimit), or
+  /// one with another resolution or block size, throws MapIoError naming the file and the reason,
+  /// and leaves this map unchanged.
   void load(const std::string& path);
 
   /// Counts; `count_observed` also walks the tree to count observed cells (O(nodes)).
