@@ -54,7 +54,7 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
     c.last_receipt = now;
     // The clock jumping backwards (a bag restarted with --clock): the tf buffer holds the old
     // future and would refuse every new scan, so clear it and go on.
-    if (!last_now_.isZero() && (last_now_ - now).toSec() > kTimeJumpThreshold) {
+    if (!last_now_.isZero() && secondsBetween(last_now_, now) > kTimeJumpThreshold) {
       ++clock_jumps_;
       clear_tf = true;
     }
@@ -62,7 +62,7 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
     // Stamps jumping backwards on one input (a bag restarted without --clock, a driver reset):
     // counted and warned; such a scan is placed by tf if its stamp is still in the buffer, else
     // dropped as too old.
-    const double back = (c.last_received_stamp - scan->header.stamp).toSec();
+    const double back = secondsBetween(c.last_received_stamp, scan->header.stamp);
     if (!c.last_received_stamp.isZero() && back > kTimeJumpThreshold) {
       ++c[Counter::kTimeJumps];
       warnLocked(in, kOtherWarning, "stamp jumped backwards by " + std::to_string(back) + " s");
@@ -74,6 +74,16 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
       detail << "frame_id '" << scan->header.frame_id << "', " << scan->ranges.size()
              << " ranges, angles [" << scan->angle_min << ", " << scan->angle_max << "] step "
              << scan->angle_increment;
+      dropLocked(in, reason, detail.str());
+      return;
+    }
+    // Before the tf filter, which adds tf_tolerance to the stamp (and would throw).
+    if (!checkScanTime(*scan, config_.ros.tf_tolerance, &reason)) {
+      std::ostringstream detail;
+      detail << "stamp " << scan->header.stamp.sec << "." << scan->header.stamp.nsec
+             << " s, time_increment " << scan->time_increment << " s over "
+             << scan->ranges.size() << " beams (sweep at most " << kMaxSweepSeconds
+             << " s, stamps within ROS time)";
       dropLocked(in, reason, detail.str());
       return;
     }
@@ -154,6 +164,17 @@ void MappingRos::Impl::dropLocked(Input* in, DropReason reason, const std::strin
   warnLocked(in, static_cast<std::size_t>(reason),
              "scan dropped (" + std::string(toString(reason)) + ", " + std::to_string(n) +
                  " so far): " + detail);
+}
+
+void MappingRos::Impl::caught(const char* where, const char* what, Input* in) {
+  std::uint64_t n = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    n = ++exceptions_;
+    if (in != nullptr) ++in->c[droppedCounter(DropReason::kException)];
+  }
+  ROS_ERROR_THROTTLE(kWarnPeriod, "%s: exception caught in the %s (%llu so far), going on: %s",
+                     pnh_.getNamespace().c_str(), where, static_cast<unsigned long long>(n), what);
 }
 
 void MappingRos::Impl::warnLocked(Input* in, std::size_t slot, const std::string& text) {
