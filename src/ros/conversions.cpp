@@ -81,6 +81,11 @@ bool addSeconds(const ros::Time& t, double seconds, ros::Time* out) {
   return true;
 }
 
+bool tfStampUsable(const ros::Time& stamp, double cache_time) {
+  ros::Time ignored;
+  return addSeconds(stamp, std::max(0.0, cache_time), &ignored);
+}
+
 double sweepSeconds(const sensor_msgs::LaserScan& scan) {
   if (scan.ranges.size() < 2) return 0.0;
   return static_cast<double>(scan.time_increment) * static_cast<double>(scan.ranges.size() - 1);

@@ -61,6 +61,7 @@ void MappingRos::Impl::diagnoseMapper(diagnostic_updater::DiagnosticStatusWrappe
   stat.add("clock jumps", clock_jumps_);
   stat.add("exceptions caught", exceptions_);
   stat.add("layers refused (too large)", layers_refused_);
+  stat.add("transforms refused", tf_refused_);
   stat.add("integration time mean (s)", last_mean_);
   stat.add("integration time max (s)", last_max_);
   stat.add("publish time (s)", publish_time_);

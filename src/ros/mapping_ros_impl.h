@@ -132,6 +132,7 @@ struct MappingRos::Impl {
   std::uint64_t clock_jumps_ = 0;
   std::uint64_t exceptions_ = 0;      ///< caught by guarded()
   std::uint64_t layers_refused_ = 0;  ///< layers larger than kMaxLayerCells, not published
+  std::uint64_t tf_refused_ = 0;      ///< transforms the tf buffer could not take
   // Integration time over the current status period.
   double integrate_time_sum_ = 0.0;
   double integrate_time_max_ = 0.0;

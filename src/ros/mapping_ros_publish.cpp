@@ -75,6 +75,7 @@ wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time&
   status->clock_jumps = clock_jumps_;
   status->exceptions = exceptions_;
   status->layers_refused = layers_refused_;
+  status->tf_refused = tf_refused_;
   last_mean_ =
       integrate_count_ > 0 ? integrate_time_sum_ / static_cast<double>(integrate_count_) : 0.0;
   last_max_ = integrate_time_max_;

@@ -97,14 +97,31 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
 }
 
 void MappingRos::Impl::onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static) {
-  std::lock_guard<std::mutex> tf_lock(tf_mutex_);
-  for (const auto& t : msg->transforms) {
-    try {
-      buffer_->setTransform(t, "default_authority", is_static);
-    } catch (const tf2::TransformException& e) {
-      ROS_WARN_THROTTLE(kWarnPeriod, "%s: transform refused by the tf buffer: %s",
-                        pnh_.getNamespace().c_str(), e.what());
+  std::uint64_t refused = 0;
+  {
+    std::lock_guard<std::mutex> tf_lock(tf_mutex_);
+    for (const auto& t : msg->transforms) {
+      // The buffer's pruning adds its cache length to the stamp and would throw.
+      if (!tfStampUsable(t.header.stamp, config_.ros.tf_cache_time)) {
+        ++refused;
+        ROS_WARN_THROTTLE(kWarnPeriod, "%s: transform %s -> %s refused: stamp %u.%09u s is too late for ROS time",
+                          pnh_.getNamespace().c_str(), t.header.frame_id.c_str(),
+                          t.child_frame_id.c_str(), t.header.stamp.sec, t.header.stamp.nsec);
+        continue;
+      }
+      try {
+        // false: refused (NaN, empty or equal frame ids...; tf2 logs why).
+        if (!buffer_->setTransform(t, "default_authority", is_static)) ++refused;
+      } catch (const tf2::TransformException& e) {
+        ++refused;
+        ROS_WARN_THROTTLE(kWarnPeriod, "%s: transform refused by the tf buffer: %s",
+                          pnh_.getNamespace().c_str(), e.what());
+      }
     }
+  }
+  if (refused > 0) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tf_refused_ += refused;
   }
 }
 

@@ -146,13 +146,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       ros::Time shifted;
       if (wavog_ros::addSeconds(stamp, hostileDouble(&in, -0.1, 0.1), &shifted)) stamp = shifted;
     }
-    tf.setTransform(decodeTransform(&in, stamp), "fuzz", in.ConsumeBool());  // may refuse
+    // As onTf: a stamp the buffer's pruning cannot take is refused before it.
+    if (!wavog_ros::tfStampUsable(stamp, 10.0)) continue;
+    try {
+      tf.setTransform(decodeTransform(&in, stamp), "fuzz", in.ConsumeBool());  // may refuse
+    } catch (const std::exception& e) {
+      WAVOG_FUZZ_CHECK(false, "setTransform threw after tfStampUsable: %s", e.what());
+    }
   }
   const double window = in.ConsumeBool() ? 0.0 : hostileDouble(&in, 0.0, 50.0);
   const double cx = hostileDouble(&in, -50.0, 50.0), cy = hostileDouble(&in, -50.0, 50.0);
 
   // onScan: the time arithmetic of the node on the stamp against another stamp.
-  ros::Time previous(hostileSec(&in), hostileNsec(&in));
+  ros::Time previous;  // fields set as deserialisation does: not normalised (nsec may pass 1e9)
+  previous.sec = hostileSec(&in);
+  previous.nsec = hostileNsec(&in);
   const double back = wavog_ros::secondsBetween(previous, scan.header.stamp);
   WAVOG_FUZZ_CHECK(std::isfinite(back), "secondsBetween not finite: %g", back);
 

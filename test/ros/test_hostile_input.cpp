@@ -1,7 +1,8 @@
 // Hostile input (issue 16, node side): each case is sent alone, then a good scan; the node must
 // stay up, count the case under its reason, and map the good scan. Cases: time_increment 1e7,
 // 1e30 and NaN, a stamp of {2^32 - 1 s, 999999999 ns}, a stamp far in the future (the next good
-// scan is 2^31 s back), lasers placed by tf 2e5 m apart (a read-out of 1.6e13 cells: the layers
+// scan is 2^31 s back), a /tf transform stamped 2^32 - 1 s (the tf buffer's pruning would throw:
+// refused, counted in tf_refused), lasers placed by tf 2e5 m apart (a read-out of 1.6e13 cells: the layers
 // are refused, not allocated), save_map outside map_dir ('..', absolute, through a symlink), and
 // a map_file that is /dev/zero, a FIFO or a directory (start-up fails at once, naming it).
 // No exception may have been needed to survive: ~status.exceptions stays 0.
@@ -10,6 +11,7 @@
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <sys/stat.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <unistd.h>
 
@@ -31,6 +33,7 @@ std::mutex g_mutex;
 nav_msgs::OccupancyGrid::ConstPtr g_map;
 MapperStatus::ConstPtr g_status;
 ros::Publisher g_scan_pub;
+ros::Publisher g_tf_pub;  ///< /tf, for a hostile transform
 
 /// base_link -> far_plus / far_minus: lasers 2e5 m either side of the robot.
 constexpr double kFar = 2e5;
@@ -117,6 +120,26 @@ TEST_F(Hostile, StampFarFromThePreviousOneCountedAsTimeJump) {
   auto future = good();
   future->header.stamp = ros::Time(4000000000u, 0);
   sendCase("stamp 4e9 s", future, &InputStatus::time_jumps, /*bad_integrated=*/true);
+}
+
+TEST_F(Hostile, TransformStampedAtTheEndOfTimeRefused) {
+  // The tf buffer's pruning adds tf_cache_time to this stamp: out of ROS time, it would throw.
+  const auto before = latestStatus();
+  ASSERT_TRUE(before);
+  room::waitForSubscribers(g_tf_pub, 1, 10.0);
+  tf2_msgs::TFMessage msg;
+  msg.transforms.push_back(
+      room::toMsg(room::sensorInBase(room::sensors()[0]), "base_link", "late_laser"));
+  msg.transforms[0].header.stamp.sec = 4294967295u;
+  msg.transforms[0].header.stamp.nsec = 0;
+  g_tf_pub.publish(msg);
+  ros::WallDuration(0.2).sleep();
+  const auto after = goodScanIntegrated(before->inputs[0].integrated);
+  ASSERT_TRUE(after);
+  const auto s = waitStatus([&](const MapperStatus& st) { return st.tf_refused > before->tf_refused; });
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->tf_refused, before->tf_refused + 1);
+  EXPECT_EQ(s->exceptions, 0u);
 }
 
 TEST_F(Hostile, HugeReadOutRefusedNotAllocated) {
@@ -232,6 +255,7 @@ int main(int argc, char** argv) {
   }
   static_tf.sendTransform(tree);
   g_scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 50);
+  g_tf_pub = nh.advertise<tf2_msgs::TFMessage>("/tf", 10);
   auto map_sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map", 2, &g_mutex, &g_map);
   auto status_sub =
       room::keepLatest<MapperStatus>(nh, "wavog_mapping/status", 10, &g_mutex, &g_status);

@@ -42,6 +42,10 @@ double secondsBetween(const ros::Time& a, const ros::Time& b);
 /// outside [0, 2^32) s, where ros::Time arithmetic would throw. Never throws.
 bool addSeconds(const ros::Time& t, double seconds, ros::Time* out);
 
+/// Whether the tf buffer can take a transform stamped `stamp` with a cache of `cache_time` s: its
+/// pruning adds cache_time to the stamps and throws beyond 2^32 s. Never throws.
+bool tfStampUsable(const ros::Time& stamp, double cache_time);
+
 /// Sweep duration (s) of a scan: time_increment x (beams - 1); 0 for fewer than 2 beams.
 double sweepSeconds(const sensor_msgs::LaserScan& scan);
 
