@@ -2,7 +2,7 @@
 # dynamic_reconfigure, and catkin_package(). Owned by the ROS layer. Everything here comes before
 # the targets that use catkin variables.
 find_package(catkin REQUIRED COMPONENTS
-  roscpp nodelet pluginlib tf2 tf2_ros tf2_eigen sensor_msgs nav_msgs geometry_msgs map_msgs
+  roscpp nodelet pluginlib tf2 tf2_ros sensor_msgs nav_msgs geometry_msgs map_msgs
   std_msgs std_srvs diagnostic_updater diagnostic_msgs dynamic_reconfigure rosbag message_generation)
 find_package(yaml-cpp REQUIRED)
 

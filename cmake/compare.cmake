@@ -21,7 +21,9 @@ set_tests_properties(baseline_test_dense_grid PROPERTIES LABELS "baseline" TIMEO
 # ---- wavog_compare: the benchmark program (needs Debian's liboctomap-dev) -----------------------
 find_package(octomap QUIET)
 if(octomap_FOUND)
-  add_executable(wavog_compare src/tools/compare.cpp)
+  add_executable(wavog_compare src/tools/compare/main.cpp src/tools/compare/options.cpp
+    src/tools/compare/workloads.cpp src/tools/compare/measure.cpp src/tools/compare/report.cpp)
+  target_include_directories(wavog_compare PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/tools)
   target_link_libraries(wavog_compare PRIVATE wavog_core wavog_io wavog_baseline wavog_tool_support
     ${OCTOMAP_LIBRARIES})
   target_include_directories(wavog_compare SYSTEM PRIVATE ${OCTOMAP_INCLUDE_DIRS})

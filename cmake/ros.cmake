@@ -23,6 +23,7 @@ if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/mapping_ros.cpp)
     src/ros/mapping_ros_publish.cpp
     src/ros/mapping_ros_diagnostics.cpp
     src/ros/mapping_ros_services.cpp
+    src/ros/mapping_ros_flush.cpp
     src/ros/save_path.cpp)
   target_include_directories(wavog_ros SYSTEM PUBLIC ${WAVOG_ROS_INCLUDES})
   target_link_libraries(wavog_ros PUBLIC wavog_ros_config wavog_io wavog_core ${catkin_LIBRARIES})
@@ -52,6 +53,16 @@ if(CATKIN_ENABLE_TESTING)
     catkin_add_gtest(test_scan_placement test/ros/test_scan_placement.cpp)
     if(TARGET test_scan_placement)
       target_link_libraries(test_scan_placement wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
+    # The file names and crop shared by ~save_map and wavog_offline (wavog_io).
+    catkin_add_gtest(test_map_files test/ros/test_map_files.cpp)
+    if(TARGET test_map_files)
+      target_link_libraries(test_map_files wavog_io ${GTEST_MAIN_LIBRARIES})
+    endif()
+    catkin_add_gtest(test_reconfigure test/ros/test_reconfigure.cpp)
+    if(TARGET test_reconfigure)
+      target_link_libraries(test_reconfigure wavog_ros ${GTEST_MAIN_LIBRARIES})
+      add_dependencies(test_reconfigure ${PROJECT_NAME}_gencfg)
     endif()
     # The node's limits (issue 16): time checks, publication sizing, save_map below map_dir.
     catkin_add_gtest(test_node_limits test/ros/test_node_limits.cpp)
@@ -99,6 +110,19 @@ if(CATKIN_ENABLE_TESTING)
     target_include_directories(test_motion SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
     target_link_libraries(test_motion ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
     add_dependencies(test_motion ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+
+    # The end of a played bag: '/' frames, no tf for one laser, last scans after the last tf.
+    add_rostest_gtest(test_bag_end test/bag_end.test test/ros/test_bag_end.cpp)
+    target_include_directories(test_bag_end SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(test_bag_end ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_bag_end ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+
+    # Live reconfigure of the policy against a core-only map; an invalid change refused.
+    add_rostest_gtest(test_reconfigure_policy test/reconfigure_policy.test
+                      test/ros/test_reconfigure_policy.cpp)
+    target_link_libraries(test_reconfigure_policy wavog_ros ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_reconfigure_policy ${PROJECT_NAME}_generate_messages_cpp
+                     ${WAVOG_ROS_RUNTIME})
 
     # Services: reset, clear_region, save_map + restart with map_file, corrupted map_file.
     find_program(WAVOG_NODELET_BIN nodelet PATHS /usr/lib/nodelet ${nodelet_PREFIX}/lib/nodelet

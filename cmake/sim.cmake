@@ -41,15 +41,12 @@ target_include_directories(wavog_simulate SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(wavog_simulate PRIVATE wavog_sim wavog_io wavog_tool_support ${catkin_LIBRARIES})
 target_compile_options(wavog_simulate PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_simulate PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_SIM_BIN_DIR})
-install(TARGETS wavog_simulate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # ---- wavog_evaluate: every policy over a scenario against ground truth (no ROS at run time) ---
-add_executable(wavog_evaluate src/tools/evaluate.cpp src/sim/plot.cpp)
-target_include_directories(wavog_evaluate PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/sim)
+add_executable(wavog_evaluate src/tools/evaluate.cpp src/tools/evaluate_output.cpp)
 target_link_libraries(wavog_evaluate PRIVATE wavog_sim_eval wavog_io wavog_tool_support Threads::Threads)
 target_compile_options(wavog_evaluate PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_evaluate PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_SIM_BIN_DIR})
-install(TARGETS wavog_evaluate RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # The bag end to end (rosbag API; maps it with wavog_offline when that is built).
 wavog_sim_test(test_simulate_bag wavog_sim)

@@ -14,9 +14,7 @@ if(TARGET wavog_ros AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/tools/offline.cpp
   target_link_libraries(wavog_offline PRIVATE wavog_tool_support wavog_ros ${catkin_LIBRARIES})
   target_compile_options(wavog_offline PRIVATE ${WAVOG_WARNINGS})
   set_target_properties(wavog_offline PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
-  install(TARGETS wavog_offline RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 endif()
-install(TARGETS wavog_log2bag RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # ---- Tests: plain gtest executables (built by `make`, unlike catkin_add_gtest) run by ctest ----
 find_package(GTest REQUIRED)
@@ -34,6 +32,9 @@ function(wavog_tools_test name)
 endfunction()
 
 wavog_tools_test(test_image_io)
+# The PNG test decodes with Python's PIL (python3-pil), independent of libpng.
+find_package(Python3 COMPONENTS Interpreter REQUIRED)
+target_compile_definitions(test_image_io PRIVATE WAVOG_PYTHON="${Python3_EXECUTABLE}")
 wavog_tools_test(test_tool_support)
 
 if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_log2bag.cpp)
@@ -91,12 +92,39 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
   endif()
 endif()
 
+# Real-bag rostest: the laser_scan_matcher demo bag (another project's driver: frame_id '/laser',
+# no tf), played through launch/playback.launch with fixed_frame_laser:=true.
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_mapping_node
+   AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/real_bag.test)
+  if(DEFINED ENV{WAVOG_DATA_DIR})
+    set(_wavog_real_bag_dir $ENV{WAVOG_DATA_DIR})
+  else()
+    get_filename_component(_wavog_real_bag_dir ${CMAKE_CURRENT_SOURCE_DIR}/../shared/data ABSOLUTE)
+  endif()
+  set(_wavog_real_bag ${_wavog_real_bag_dir}/laser_scan_matcher_demo.bag)
+  if(EXISTS ${_wavog_real_bag})
+    find_package(rostest REQUIRED)
+    add_executable(test_real_bag test/tools/test_real_bag.cpp)
+    target_include_directories(test_real_bag SYSTEM PRIVATE ${catkin_INCLUDE_DIRS}
+                               ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
+    target_link_libraries(test_real_bag PRIVATE ${catkin_LIBRARIES} GTest::GTest)
+    target_compile_options(test_real_bag PRIVATE ${WAVOG_WARNINGS})
+    set_target_properties(test_real_bag PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
+    add_dependencies(test_real_bag ${PROJECT_NAME}_generate_messages_cpp)
+    add_rostest(test/tools/real_bag.test DEPENDENCIES test_real_bag wavog_mapping_node wavog_static_tf)
+    set_tests_properties(_ctest_${PROJECT_NAME}_rostest_test_tools_real_bag.test PROPERTIES
+                         LABELS "tools;rostest" TIMEOUT 200
+                         ENVIRONMENT "WAVOG_REAL_BAG=${_wavog_real_bag}")
+  else()
+    message(STATUS "wavog tools: ${_wavog_real_bag} not found; real-bag rostest not registered")
+  endif()
+endif()
+
 # ---- wavog_paper (issue 17): the paper's figures from fr079 (make paper; no ROS at run time) ---
 find_package(CLI11 CONFIG REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 add_executable(wavog_paper src/tools/paper.cpp)
-target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io CLI11::CLI11
+target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io wavog_tool_support CLI11::CLI11
                       nlohmann_json::nlohmann_json Threads::Threads)
 target_compile_options(wavog_paper PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_paper PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
-install(TARGETS wavog_paper RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

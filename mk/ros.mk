@@ -1,9 +1,11 @@
 # ROS layer targets (issue 3). Neither is part of `make test`.
-#   make tsan         ThreadSanitizer build of the node in $(BUILD_TSAN); runs the integration and
-#                     bad-input rostests against it (4 scan inputs, tf, timers on 4 threads).
+#   make tsan         ThreadSanitizer build of the node in $(BUILD_TSAN); runs the integration,
+#                     bad-input, bag-end and reconfigure rostests against it (4 scan inputs, tf,
+#                     timers on 4 threads; the idle flush racing the tf filters; live reconfigure).
 #                     roscpp-internal reports are suppressed (test/ros/tsan.supp). ~4 min on 2 cores.
-#   make rviz-check   installs rviz + Xvfb (separate from `make deps`), runs rviz/wavog.rviz under
-#                     Xvfb against the integration scene and writes $(RVIZ_SHOT).
+#   make rviz-check   installs rviz + Xvfb (separate from `make deps`), plays 40 s of the simulated
+#                     car park through launch/playback.launch (config/lms291_x4.yaml) with
+#                     rviz/wavog.rviz under Xvfb and writes $(RVIZ_SHOT). About 1 minute.
 BUILD_TSAN ?= $(ROOT)/build-tsan
 RVIZ_SHOT ?= $(ROOT)/build/rviz_screenshot.png
 ROS_ENV := export ROS_DISTRO=Debian ROS_MASTER_URI=$${ROS_MASTER_URI:-http://localhost:11311}
@@ -16,12 +18,13 @@ tsan: deps
 	  -DWAVOG_SANITIZE=thread -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  >$(BUILD_TSAN)/configure.log || { cat $(BUILD_TSAN)/configure.log; exit 1; }
 	@bash $(ROOT)/scripts/build.sh $(BUILD_TSAN) $(JOBS) wavog_mapping_node test_mapping_system \
-	  test_bad_input
+	  test_bad_input test_bag_end test_reconfigure_policy
 	@rm -f $(BUILD_TSAN)/tsan/report.*
 	@$(ROS_ENV); source $(BUILD_TSAN)/devel/setup.bash; \
 	  export ROS_HOME=$(BUILD_TSAN)/ros_home; \
 	  export TSAN_OPTIONS="log_path=$(BUILD_TSAN)/tsan/report second_deadlock_stack=1 history_size=4 suppressions=$(ROOT)/test/ros/tsan.supp"; \
-	  rostest wavog_mapping mapping_node.test && rostest wavog_mapping bad_input.test
+	  rostest wavog_mapping mapping_node.test && rostest wavog_mapping bad_input.test && \
+	  rostest wavog_mapping bag_end.test && rostest wavog_mapping reconfigure_policy.test
 	@if ls $(BUILD_TSAN)/tsan/report.* >/dev/null 2>&1; then \
 	  cat $(BUILD_TSAN)/tsan/report.*; echo "tsan: ThreadSanitizer reports above"; exit 1; \
 	else echo "tsan: no data race reported"; fi

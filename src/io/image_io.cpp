@@ -1,10 +1,8 @@
-// PNG / PGM / map_server YAML writers (and small readers for tests and tools). The PNG encoder
-// writes one IDAT of zlib-compressed rows, each with the filter type that suits it best; the reader
-// accepts all five filter types of the PNG spec, so it also reads files from other encoders that
-// use 8-bit grey or RGB without interlacing.
+// PNG / PGM / map_server YAML writers (and small readers for tests and tools). PNG goes through
+// libpng's simplified API (8-bit grey or RGB); PGM and the YAML are written here.
 #include "wavog_mapping/io/image_io.h"
 
-#include <zlib.h>
+#include <png.h>
 
 #include <algorithm>
 #include <array>
@@ -23,9 +21,6 @@
 namespace wavog {
 namespace {
 
-constexpr std::array<std::uint8_t, 8> kPngSignature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-constexpr int kPngColourGrey = 0;
-constexpr int kPngColourRgb = 2;
 constexpr std::size_t kMaxPngPixels = std::size_t{1} << 30;  // refuse absurd sizes when reading
 
 void checkImage(const std::string& path, const Image& image) {
@@ -53,68 +48,6 @@ std::string readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open: " + std::strerror(errno));
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void putBe32(std::string* out, std::uint32_t v) {
-  for (int shift = 24; shift >= 0; shift -= 8)
-    out->push_back(static_cast<char>((v >> shift) & 0xffu));
-}
-
-std::uint32_t getBe32(const std::string& s, std::size_t pos) {
-  std::uint32_t v = 0;
-  for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<std::uint8_t>(s[pos + i]);
-  return v;
-}
-
-void putChunk(std::string* out, const char type[4], const std::string& data) {
-  putBe32(out, static_cast<std::uint32_t>(data.size()));
-  std::string body(type, 4);
-  body += data;
-  out->append(body);
-  const auto crc =
-      crc32(0L, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()));
-  putBe32(out, static_cast<std::uint32_t>(crc));
-}
-
-/// zlib stream of `raw` at the best compression; throws naming `path` on failure.
-std::string deflate(const std::string& path, const std::string& raw) {
-  uLongf size = compressBound(static_cast<uLong>(raw.size()));
-  std::string packed(size, '\0');
-  if (compress2(reinterpret_cast<Bytef*>(&packed[0]), &size,
-                reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()),
-                Z_BEST_COMPRESSION) != Z_OK) {
-    throw std::runtime_error(path + ": zlib compression failed");
-  }
-  packed.resize(size);
-  return packed;
-}
-
-/// Paeth predictor of the PNG spec (filter type 4).
-std::uint8_t paeth(int a, int b, int c) {
-  const int p = a + b - c;
-  const int pa = std::abs(p - a);
-  const int pb = std::abs(p - b);
-  const int pc = std::abs(p - c);
-  if (pa <= pb && pa <= pc) return static_cast<std::uint8_t>(a);
-  if (pb <= pc) return static_cast<std::uint8_t>(b);
-  return static_cast<std::uint8_t>(c);
-}
-
-/// PNG filter `type` 0..4 (none, sub, up, average, Paeth): the prediction of a byte from its left
-/// (a), upper (b) and upper-left (c) neighbours.
-int predict(int type, int a, int b, int c) {
-  switch (type) {
-    case 1:
-      return a;
-    case 2:
-      return b;
-    case 3:
-      return (a + b) / 2;
-    case 4:
-      return paeth(a, b, c);
-    default:
-      return 0;
-  }
 }
 
 /// Image row of raster row `ry` (rows are flipped so that +y is up in the picture).
@@ -189,62 +122,16 @@ Image renderGrey(const Raster& raster, const RenderOptions& options) {
 
 void writePng(const std::string& path, const Image& image) {
   checkImage(path, image);
-  const std::size_t stride =
-      static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.channels);
-  // Two encodings, the smaller one kept: no filter, and per row the filter type with the smallest
-  // sum of |signed residuals| (the PNG spec's heuristic), which wins on smooth pictures but can
-  // lose on graded maps with sharp edges.
-  const std::size_t bpp = static_cast<std::size_t>(image.channels);
-  std::string plain;
-  std::string filtered;
-  plain.reserve((stride + 1) * static_cast<std::size_t>(image.height));
-  filtered.reserve(plain.capacity());
-  std::array<std::vector<std::uint8_t>, 5> candidates;
-  for (auto& c : candidates) c.resize(stride);
-  for (int y = 0; y < image.height; ++y) {
-    const std::uint8_t* row = image.at(0, y);
-    const std::uint8_t* up = y > 0 ? image.at(0, y - 1) : nullptr;
-    plain.push_back('\0');
-    plain.append(reinterpret_cast<const char*>(row), stride);
-    std::size_t best = 0;
-    long best_cost = -1;
-    for (std::size_t f = 0; f < candidates.size(); ++f) {
-      long cost = 0;
-      for (std::size_t i = 0; i < stride; ++i) {
-        const int a = i >= bpp ? row[i - bpp] : 0;
-        const int b = up ? up[i] : 0;
-        const int c = (up && i >= bpp) ? up[i - bpp] : 0;
-        const int predicted = predict(static_cast<int>(f), a, b, c);
-        const auto residual = static_cast<std::uint8_t>((row[i] - predicted) & 0xff);
-        candidates[f][i] = residual;
-        cost += residual < 128 ? residual : 256 - residual;
-      }
-      if (best_cost < 0 || cost < best_cost) {
-        best_cost = cost;
-        best = f;
-      }
-    }
-    filtered.push_back(static_cast<char>(best));
-    filtered.append(reinterpret_cast<const char*>(candidates[best].data()), stride);
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = static_cast<png_uint_32>(image.width);
+  png.height = static_cast<png_uint_32>(image.height);
+  png.format = image.channels == 1 ? PNG_FORMAT_GRAY : PNG_FORMAT_RGB;
+  if (!png_image_write_to_file(&png, path.c_str(), 0, image.pixels.data(), 0, nullptr)) {
+    const std::string why = png.message;
+    png_image_free(&png);
+    throw std::runtime_error(path + ": cannot write the PNG: " + why);
   }
-  const std::string a = deflate(path, plain);
-  const std::string b = deflate(path, filtered);
-  const std::string& packed = a.size() <= b.size() ? a : b;
-
-  std::string ihdr;
-  putBe32(&ihdr, static_cast<std::uint32_t>(image.width));
-  putBe32(&ihdr, static_cast<std::uint32_t>(image.height));
-  ihdr.push_back(8);  // bit depth
-  ihdr.push_back(static_cast<char>(image.channels == 1 ? kPngColourGrey : kPngColourRgb));
-  ihdr.push_back(0);  // compression: deflate
-  ihdr.push_back(0);  // filter method 0
-  ihdr.push_back(0);  // no interlace
-
-  std::string out(kPngSignature.begin(), kPngSignature.end());
-  putChunk(&out, "IHDR", ihdr);
-  putChunk(&out, "IDAT", packed);
-  putChunk(&out, "IEND", "");
-  writeFile(path, out);
 }
 
 void writePgm(const std::string& path, const Image& image) {
@@ -257,80 +144,22 @@ void writePgm(const std::string& path, const Image& image) {
 }
 
 Image readPng(const std::string& path) {
-  const std::string file = readFile(path);
-  auto fail = [&path](const std::string& why) -> std::runtime_error {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  auto fail = [&](const std::string& why) {
+    png_image_free(&png);
     return std::runtime_error(path + ": not a readable PNG: " + why);
   };
-  if (file.size() < 8 ||
-      !std::equal(kPngSignature.begin(), kPngSignature.end(), file.begin(),
-                  [](std::uint8_t a, char b) { return a == static_cast<std::uint8_t>(b); })) {
-    throw fail("bad signature");
+  if (!png_image_begin_read_from_file(&png, path.c_str())) throw fail(png.message);
+  if (png.width == 0 || png.height == 0 ||
+      static_cast<std::size_t>(png.width) * png.height > kMaxPngPixels) {
+    throw fail("bad size");
   }
-  Image image;
-  std::string idat;
-  bool have_header = false;
-  bool ended = false;
-  std::size_t pos = 8;
-  while (!ended) {
-    if (pos + 12 > file.size()) throw fail("truncated chunk");
-    const std::uint32_t len = getBe32(file, pos);
-    if (len > file.size() - pos - 12) throw fail("truncated chunk");
-    const std::string type = file.substr(pos + 4, 4);
-    const auto crc = crc32(0L, reinterpret_cast<const Bytef*>(file.data() + pos + 4), len + 4);
-    if (static_cast<std::uint32_t>(crc) != getBe32(file, pos + 8 + len)) {
-      throw fail("CRC mismatch in chunk " + type);
-    }
-    const std::string data = file.substr(pos + 8, len);
-    if (type == "IHDR") {
-      if (len != 13) throw fail("bad IHDR");
-      image.width = static_cast<int>(getBe32(data, 0));
-      image.height = static_cast<int>(getBe32(data, 4));
-      const int depth = static_cast<std::uint8_t>(data[8]);
-      const int colour = static_cast<std::uint8_t>(data[9]);
-      if (depth != 8 || (colour != kPngColourGrey && colour != kPngColourRgb) || data[12] != 0) {
-        throw fail("only 8-bit grey or RGB without interlacing is supported");
-      }
-      image.channels = colour == kPngColourGrey ? 1 : 3;
-      if (image.width <= 0 || image.height <= 0 ||
-          static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) >
-              kMaxPngPixels) {
-        throw fail("bad size");
-      }
-      have_header = true;
-    } else if (type == "IDAT") {
-      idat += data;
-    } else if (type == "IEND") {
-      ended = true;
-    }
-    pos += 12 + len;
-  }
-  if (!have_header) throw fail("no IHDR");
-  const std::size_t stride =
-      static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.channels);
-  const std::size_t height = static_cast<std::size_t>(image.height);
-  std::string raw((stride + 1) * height, '\0');
-  uLongf raw_size = static_cast<uLongf>(raw.size());
-  if (uncompress(reinterpret_cast<Bytef*>(&raw[0]), &raw_size,
-                 reinterpret_cast<const Bytef*>(idat.data()),
-                 static_cast<uLong>(idat.size())) != Z_OK ||
-      raw_size != raw.size()) {
-    throw fail("damaged image data");
-  }
-  image.pixels.assign(stride * height, 0);
-  const std::size_t bpp = static_cast<std::size_t>(image.channels);
-  for (std::size_t y = 0; y < height; ++y) {
-    const auto filter = static_cast<std::uint8_t>(raw[y * (stride + 1)]);
-    if (filter > 4) throw fail("bad filter type " + std::to_string(filter));
-    const auto* in = reinterpret_cast<const std::uint8_t*>(raw.data()) + y * (stride + 1) + 1;
-    std::uint8_t* out = image.pixels.data() + y * stride;
-    const std::uint8_t* up = y > 0 ? out - stride : nullptr;
-    for (std::size_t i = 0; i < stride; ++i) {
-      const int a = i >= bpp ? out[i - bpp] : 0;
-      const int b = up ? up[i] : 0;
-      const int c = (up && i >= bpp) ? up[i - bpp] : 0;
-      const int predicted = predict(filter, a, b, c);
-      out[i] = static_cast<std::uint8_t>((in[i] + predicted) & 0xff);
-    }
+  const bool colour = (png.format & PNG_FORMAT_FLAG_COLOR) != 0;
+  png.format = colour ? PNG_FORMAT_RGB : PNG_FORMAT_GRAY;
+  Image image(static_cast<int>(png.width), static_cast<int>(png.height), colour ? 3 : 1);
+  if (!png_image_finish_read(&png, nullptr, image.pixels.data(), 0, nullptr)) {
+    throw fail(png.message);
   }
   return image;
 }

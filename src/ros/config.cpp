@@ -163,6 +163,7 @@ const std::vector<KeyReader>& readers() {
       {"map_dir", [](auto& k, auto& v, Config* c) { c->ros.map_dir = asString(k, v); }},
       {"rate_tolerance",
        [](auto& k, auto& v, Config* c) { c->ros.rate_tolerance = asDouble(k, v); }},
+      {"idle_timeout", [](auto& k, auto& v, Config* c) { c->ros.idle_timeout = asDouble(k, v); }},
   };
   return kReaders;
 }
@@ -290,6 +291,8 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
         &e, "map_dir ('" + ros.map_dir + "') must be an absolute path without '..' (empty: the ROS home)");
   check(std::isfinite(ros.rate_tolerance) && ros.rate_tolerance >= 0.0 && ros.rate_tolerance < 1.0,
         &e, "rate_tolerance (" + fmt(ros.rate_tolerance) + ") must be in [0, 1)");
+  check(std::isfinite(ros.idle_timeout) && ros.idle_timeout >= 0.0 && ros.idle_timeout <= 3600.0,
+        &e, "idle_timeout (" + fmt(ros.idle_timeout) + ") must be in [0, 3600] s (0: never)");
   return e;
 }
 

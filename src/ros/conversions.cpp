@@ -36,6 +36,17 @@ const char* toString(DropReason reason) {
   return i < kNumDropReasons ? kNames[i] : "unknown";
 }
 
+bool stripFrameSlash(std::string* frame_id) {
+  if (frame_id->empty() || (*frame_id)[0] != '/') return false;
+  frame_id->erase(0, 1);
+  return true;
+}
+
+std::string frameSlashWarning(const std::string& frame_id) {
+  return "frame_id '" + frame_id + "' has a leading '/' (tf1 style), which tf2 refuses: using '" +
+         frame_id.substr(1) + "' for this input (warned once)";
+}
+
 bool checkScan(const sensor_msgs::LaserScan& scan, DropReason* reason) {
   const std::string& frame = scan.header.frame_id;
   if (frame.empty() || frame[0] == '/') {

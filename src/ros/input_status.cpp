@@ -33,6 +33,7 @@ constexpr CounterRow kRows[] = {
      &InputStatus::dropped_exception},
     {Counter::kTimeJumps, "time jumps", &InputStatus::time_jumps},
     {Counter::kMotionFallbacks, "motion fallbacks", &InputStatus::motion_fallbacks},
+    {Counter::kIntegratedLatestTf, "integrated with latest tf", &InputStatus::integrated_latest_tf},
     {Counter::kBeamsInvalid, "beams invalid", &InputStatus::beams_invalid},
     {Counter::kBeamsNoReturn, "beams no return", &InputStatus::beams_no_return},
 };

@@ -24,6 +24,7 @@ enum class Counter : std::size_t {
   kDroppedFirst,  ///< + DropReason: dropped_empty ... dropped_bad_geometry
   kTimeJumps = kDroppedFirst + kNumDropReasons,
   kMotionFallbacks,
+  kIntegratedLatestTf,  ///< integrated with the latest tf when the input stopped (end of a bag)
   kBeamsInvalid,
   kBeamsNoReturn,
 };

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "wavog_mapping/io/map_files.h"
 #include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_ros {
@@ -89,8 +90,14 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
     }
     const wavog::Aggregation aggregation =
         layer.scale == 0 ? wavog::Aggregation::kMean : params.scale_aggregation;
-    layer.raster = size == LayerSize::kOk ? map.exportScale(layer.scale, box, aggregation)
-                                          : emptyRaster(layer.scale, map.resolution());
+    // Cut to the observed cells: stored blocks are whole (2^block_levels cells a side) and a
+    // window may reach beyond what was seen; neither belongs in the message.
+    wavog::CellBox known;
+    layer.raster = emptyRaster(layer.scale, map.resolution());
+    if (size == LayerSize::kOk) {
+      wavog::Raster r = map.exportScale(layer.scale, box, aggregation);
+      if (wavog::knownBox(r, &known)) layer.raster = wavog::cropToKnown(r, 0);
+    }
     if (layer.scale == 0) {
       // The dirty region is reset by map_updates only: re-sending an area the full map already
       // carries is harmless, while two timers of the same period would otherwise starve updates.

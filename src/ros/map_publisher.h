@@ -56,7 +56,8 @@ class MapPublisher {
   void markAllDirty(double resolution);
 
   /// Reads `map` and every layer with subscribers, within `window` (half-width w around cx, cy)
-  /// when w > 0, else the whole map. Caller's lock.
+  /// when w > 0, else the whole map, cut to the box of the observed cells (an empty layer when
+  /// none is). Caller's lock.
   Layers read(const wavog::WaveletMap& map, const RosParams& params, double cx, double cy);
   /// Publishes what read() returned. No lock needed.
   static void publish(const Layers& layers, const std::string& frame, const ros::Time& stamp);

@@ -3,6 +3,7 @@
 // they lead to live in the files named in mapping_ros_impl.h.
 #include "wavog_mapping/ros/mapping_ros.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "mapping_ros_impl.h"
@@ -67,6 +68,7 @@ MappingRos::Impl::~Impl() {
   publish_timer_.stop();
   update_timer_.stop();
   diag_timer_.stop();
+  idle_timer_.stop();
   tf_sub_.shutdown();
   tf_static_sub_.shutdown();
   for (auto& in : inputs_) in->sub.shutdown();
@@ -108,8 +110,9 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
       }));
   in->filter->registerFailureCallback(
       boost::function<void(const LaserScan::ConstPtr&, FailureReason)>(
-          [this, raw](const LaserScan::ConstPtr&, FailureReason reason) {
-            guarded("tf filter failure callback", nullptr, [&] { onFilterFailure(raw, reason); });
+          [this, raw](const LaserScan::ConstPtr& scan, FailureReason reason) {
+            guarded("tf filter failure callback", nullptr,
+                    [&] { onFilterFailure(raw, scan, reason); });
           }));
   in->sub = nh_.subscribe<LaserScan>(
       ic.topic, kSubscriberQueue,
@@ -133,15 +136,14 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
 }
 
 void MappingRos::Impl::startReconfigure() {
-  // dynamic_reconfigure starts from the loaded configuration (not from the .cfg defaults, which
-  // are only the "forget" policy's).
-  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<wavog_mapping::MappingConfig>>(
-      reconfigure_mutex_, pnh_);
-  wavog_mapping::MappingConfig rc = toReconfigure(config_);
-  reconfigure_->updateConfig(rc);
-  reconfigure_->setCallback([this](wavog_mapping::MappingConfig& c, std::uint32_t level) {
-    guarded("reconfigure callback", nullptr, [&] { onReconfigure(c, level); });
-  });
+  // The server starts from the loaded configuration (not from the .cfg defaults, which are only
+  // the "forget" policy's).
+  reconfigure_ = std::make_unique<ReconfigureServer>(
+      pnh_, toReconfigure(config_), [this](const wavog_mapping::MappingConfig& rc) {
+        std::vector<std::string> errors = {"internal error (logged)"};
+        guarded("reconfigure callback", nullptr, [&] { errors = onReconfigure(rc); });
+        return errors;
+      });
 }
 
 void MappingRos::Impl::startTimers() {
@@ -160,29 +162,35 @@ void MappingRos::Impl::startTimers() {
   diag_timer_ = nh_.createTimer(ros::Duration(kDiagnosticsPeriod), [this](const ros::TimerEvent&) {
     guarded("diagnostics timer", nullptr, [&] { updater_->update(); });
   });
+  if (rp.idle_timeout > 0.0) {
+    // Wall time: with use_sim_time the clock stops with the bag, and ROS timers with it.
+    noteActivity();
+    idle_timer_ = nh_.createWallTimer(ros::WallDuration(std::min(0.25, rp.idle_timeout / 4.0)),
+                                      [this](const ros::WallTimerEvent& e) {
+                                        guarded("idle timer", nullptr, [&] { onIdleTimer(e); });
+                                      });
+  }
 }
 
-void MappingRos::Impl::onReconfigure(wavog_mapping::MappingConfig& rc, std::uint32_t) {
+std::vector<std::string> MappingRos::Impl::onReconfigure(const wavog_mapping::MappingConfig& rc) {
   // The timer is re-armed after the lock is released (roscpp's timer manager has locks of its own).
   double new_period = 0.0;
+  std::vector<std::string> errors;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<std::string> errors;
     const Config next = withReconfigure(config_, rc, &errors);
     if (errors.empty()) {
       try {
-        map_.setPolicy(next.map.policy, next.map.sensor);
+        map_.setPolicy(next.map.policy, next.map.sensor);  // applies pending forgetting first
       } catch (const std::invalid_argument& e) {
         errors.emplace_back(e.what());
       }
     }
-    if (!errors.empty()) {
-      std::string text;
-      for (const auto& e : errors) text += "\n  " + e;
-      ROS_ERROR("%s: reconfiguration refused, keeping the previous values:%s",
-                pnh_.getNamespace().c_str(), text.c_str());
-      rc = toReconfigure(config_);  // handed back to the server (and its clients)
-      return;
+    if (!errors.empty()) return errors;  // the server logs them and answers the values in force
+    if (next.map.policy.type != config_.map.policy.type ||
+        next.map.policy.init != config_.map.policy.init) {
+      ROS_INFO("%s: policy %s, init %s from now on", pnh_.getNamespace().c_str(),
+               wavog::toString(next.map.policy.type), wavog::toString(next.map.policy.init));
     }
     if (next.ros.publish_rate != config_.ros.publish_rate) new_period = 1.0 / next.ros.publish_rate;
     // Only the run-time fields: the others (frames, ...) are read without the lock.
@@ -192,6 +200,7 @@ void MappingRos::Impl::onReconfigure(wavog_mapping::MappingConfig& rc, std::uint
     publisher_->advertiseScales(next.ros.publish_scales);
   }
   if (new_period > 0.0) publish_timer_.setPeriod(ros::Duration(new_period));
+  return errors;
 }
 
 MappingRos::MappingRos(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)

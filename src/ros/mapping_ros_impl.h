@@ -2,22 +2,23 @@
 // role: mapping_ros.cpp (construction: inputs, tf, publishers, services, reconfigure, timers),
 // mapping_ros_scans.cpp (one scan, from the callback to the core call), mapping_ros_publish.cpp
 // (timers: layers, map_updates, ~status), mapping_ros_diagnostics.cpp (/diagnostics),
-// mapping_ros_services.cpp (~reset, ~clear_region, ~save_map).
+// mapping_ros_services.cpp (~reset, ~clear_region, ~save_map, ~flush), mapping_ros_flush.cpp (the
+// end of the input: scans still waiting for tf, the last publication).
 #ifndef WAVOG_MAPPING_SRC_ROS_MAPPING_ROS_IMPL_H_
 #define WAVOG_MAPPING_SRC_ROS_MAPPING_ROS_IMPL_H_
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
-#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
+#include <std_srvs/Trigger.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 
 #include <array>
-#include <boost/thread/recursive_mutex.hpp>
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -25,6 +26,7 @@
 
 #include "input_status.h"
 #include "map_publisher.h"
+#include "reconfigure.h"
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"
 #include "wavog_mapping/MappingConfig.h"
@@ -53,6 +55,11 @@ struct Input {
   double min_freq = 0.0;  ///< diagnostics bounds (the FrequencyStatus keeps pointers to them)
   double max_freq = 0.0;
   diagnostic_updater::FrequencyStatus* freq = nullptr;  ///< owned by Impl::freq_; may be null
+  bool slash_warned = false;  ///< the leading-'/' warning was given (guarded by Impl::mutex_)
+  /// Scans handed to the tf filter and not yet out of it (integrated, dropped or flushed), oldest
+  /// first; whoever removes a scan from here owns it. Guarded by Impl::mutex_. At most about
+  /// queue_size long: the filter reports every scan it drops.
+  std::vector<sensor_msgs::LaserScan::ConstPtr> pending;
 };
 
 struct MappingRos::Impl {
@@ -64,13 +71,17 @@ struct MappingRos::Impl {
   void addInput(const InputConfig& ic);
   void startReconfigure();
   void startTimers();
-  void onReconfigure(wavog_mapping::MappingConfig& rc, std::uint32_t level);
+  /// Applies a reconfiguration, or returns every reason to refuse it (then nothing changes).
+  std::vector<std::string> onReconfigure(const wavog_mapping::MappingConfig& rc);
 
   // ---- one scan (mapping_ros_scans.cpp), in the order a scan passes them
   void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan);
   void onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static);
-  void onFilterFailure(Input* in, tf2_ros::filter_failure_reasons::FilterFailureReason reason);
+  void onFilterFailure(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
+                       tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onTransformable(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan);
+  /// Removes `scan` from in->pending; false if it was not there (flushed or already handled).
+  bool takePendingLocked(Input* in, const sensor_msgs::LaserScan* scan);
   void integrateLocked(Input* in, const sensor_msgs::LaserScan& scan,
                        const ScanPlacement& placement);
   void dropLocked(Input* in, DropReason reason, const std::string& detail);
@@ -92,8 +103,19 @@ struct MappingRos::Impl {
     }
   }
 
+  // ---- the end of the input (mapping_ros_flush.cpp)
+  /// Input stopped for idle_timeout (wall time: a bag's clock stops with it): flush, publish.
+  void onIdleTimer(const ros::WallTimerEvent&);
+  /// Integrates every scan still waiting for tf with the latest transform of its frame (the tf
+  /// buffer has nothing newer); returns how many were integrated.
+  std::size_t flushPending();
+  /// Something arrived (a scan or tf): the input is not idle.
+  void noteActivity();
+
   // ---- publication and status (mapping_ros_publish.cpp)
   void onPublishTimer(const ros::TimerEvent&);
+  /// Reads and publishes every layer and ~status now (timer, end of input, services).
+  void publishAll();
   void onUpdateTimer(const ros::TimerEvent&);
   wavog_mapping::MapperStatus::Ptr statusLocked(const ros::Time& now);
 
@@ -107,6 +129,7 @@ struct MappingRos::Impl {
   bool onClearRegion(wavog_mapping::ClearRegion::Request& req,
                      wavog_mapping::ClearRegion::Response& res);
   bool onSaveMap(wavog_mapping::SaveMap::Request& req, wavog_mapping::SaveMap::Response& res);
+  bool onFlush(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
 
   ros::NodeHandle nh_, pnh_;
   Config config_;  ///< the run-time part changes only in onReconfigure(); guarded by mutex_
@@ -141,17 +164,22 @@ struct MappingRos::Impl {
   double publish_time_ = 0.0;
   ros::Time last_status_time_;
   std::uint64_t tf_failures_reported_ = 0;  ///< tf failures at the last diagnostics update
+  /// Steady-clock time (ns) of the last scan or tf message; read by the idle timer.
+  std::atomic<std::int64_t> last_activity_ns_{0};
+  /// The current idle period was handled (flushed and published); cleared by noteActivity().
+  std::atomic<bool> idle_handled_{false};
+  bool changed_since_publish_ = false;  ///< the map changed since the last publishAll()
   std::unique_ptr<MapPublisher> publisher_;
 
   ros::Publisher status_pub_;
-  ros::ServiceServer reset_srv_, clear_srv_, save_srv_;
+  ros::ServiceServer reset_srv_, clear_srv_, save_srv_, flush_srv_;
   ros::Timer publish_timer_, update_timer_, diag_timer_;
+  ros::WallTimer idle_timer_;
 
   std::unique_ptr<diagnostic_updater::Updater> updater_;
   std::vector<std::unique_ptr<diagnostic_updater::FrequencyStatus>> freq_;
 
-  boost::recursive_mutex reconfigure_mutex_;
-  std::unique_ptr<dynamic_reconfigure::Server<wavog_mapping::MappingConfig>> reconfigure_;
+  std::unique_ptr<ReconfigureServer> reconfigure_;
 };
 
 }  // namespace wavog_ros

@@ -1,5 +1,6 @@
 // MappingRos's timers: the full publication of every layer with the ~status of the period that
-// ends (onPublishTimer), and map_updates (onUpdateTimer). The map is read under the lock; messages
+// ends (onPublishTimer -> publishAll, also called at the end of the input and by the services),
+// and map_updates (onUpdateTimer). The map is read under the lock; messages
 // are built and sent after it is released.
 #include <ros/ros.h>
 #include <tf2/exceptions.h>
@@ -11,7 +12,9 @@
 
 namespace wavog_ros {
 
-void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
+void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) { publishAll(); }
+
+void MappingRos::Impl::publishAll() {
   const auto t_start = std::chrono::steady_clock::now();
   const ros::Time now = ros::Time::now();
   const RosParams& rp = config_.ros;
@@ -37,7 +40,10 @@ void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) {
   wavog_mapping::MapperStatus::Ptr status;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (window_ok) layers = publisher_->read(map_, rp, cx, cy);
+    if (window_ok) {
+      layers = publisher_->read(map_, rp, cx, cy);
+      changed_since_publish_ = false;
+    }
     layers_refused_ += layers.refused.size();
     status = statusLocked(now);
   }

@@ -6,6 +6,7 @@
 #include <tf2/exceptions.h>
 
 #include <algorithm>
+#include <boost/make_shared.hpp>
 #include <chrono>
 #include <sstream>
 
@@ -42,12 +43,25 @@ std::string refusalDetail(wavog::ScanStatus status) {
 
 }  // namespace
 
-void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan) {
+void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& received) {
   if (in->freq) in->freq->tick();  // FrequencyStatus locks itself
+  noteActivity();
   const ros::Time now = ros::Time::now();
+  // tf1-era frame ids ("/laser"): tf2 refuses them, so the scan goes on with the slash removed.
+  sensor_msgs::LaserScan::ConstPtr scan = received;
+  bool stripped = false;
+  if (!received->header.frame_id.empty() && received->header.frame_id[0] == '/') {
+    auto copy = boost::make_shared<sensor_msgs::LaserScan>(*received);
+    stripped = stripFrameSlash(&copy->header.frame_id);
+    scan = copy;
+  }
   bool clear_tf = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (stripped && !in->slash_warned) {
+      in->slash_warned = true;
+      ROS_WARN("%s: %s", in->topic.c_str(), frameSlashWarning(received->header.frame_id).c_str());
+    }
     InputCounters& c = in->c;
     ++c[Counter::kReceived];
     ++c.received_in_period;
@@ -87,6 +101,7 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
       dropLocked(in, reason, detail.str());
       return;
     }
+    in->pending.push_back(scan);  // before the filter may hand it on
   }
   std::lock_guard<std::mutex> tf_lock(tf_mutex_);
   if (clear_tf) {
@@ -97,6 +112,7 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
 }
 
 void MappingRos::Impl::onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static) {
+  noteActivity();
   std::uint64_t refused = 0;
   {
     std::lock_guard<std::mutex> tf_lock(tf_mutex_);
@@ -126,8 +142,10 @@ void MappingRos::Impl::onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_st
 }
 
 void MappingRos::Impl::onFilterFailure(
-    Input* in, tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+    Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
+    tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!takePendingLocked(in, scan.get())) return;  // already flushed
   if (reason == tf2_ros::filter_failure_reasons::OutTheBack) {
     dropLocked(in, DropReason::kTfTooOld, "stamp older than the tf buffer");
   } else if (reason == tf2_ros::filter_failure_reasons::EmptyFrameID) {
@@ -142,6 +160,7 @@ void MappingRos::Impl::onTransformable(Input* in, const sensor_msgs::LaserScan::
   // tf lookups outside the lock: the buffer locks itself.
   const ScanPlacement placement = placeScan(*buffer_, *scan, placement_);
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!takePendingLocked(in, scan.get())) return;  // flushed meanwhile (flushPending)
   if (!placement.placed()) {
     dropLocked(in, DropReason::kTfUnavailable, placement.error);
     return;
@@ -151,6 +170,15 @@ void MappingRos::Impl::onTransformable(Input* in, const sensor_msgs::LaserScan::
     warnLocked(in, kOtherWarning, "no tf at the end of the sweep: motion compensation skipped");
   }
   integrateLocked(in, *scan, placement);
+}
+
+bool MappingRos::Impl::takePendingLocked(Input* in, const sensor_msgs::LaserScan* scan) {
+  auto& p = in->pending;
+  const auto it =
+      std::find_if(p.begin(), p.end(), [scan](const auto& s) { return s.get() == scan; });
+  if (it == p.end()) return false;
+  p.erase(it);
+  return true;
 }
 
 void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& scan,
@@ -171,6 +199,7 @@ void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& 
     return;
   }
   ++c[Counter::kIntegrated];
+  changed_since_publish_ = true;
   c.last_stamp = scan.header.stamp;
   const double reach = wavog::scanReach(view, map_.params().sensor, map_.resolution());
   publisher_->touched({pose.x - reach, pose.y - reach, pose.x + reach, pose.y + reach});

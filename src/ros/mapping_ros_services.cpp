@@ -1,13 +1,17 @@
-// MappingRos's services: ~reset (forget the map), ~clear_region (forget a box) and ~save_map (the
-// native map plus one map_server image per published scale). Each answers with success and a
-// message; none throws.
+// MappingRos's services: ~reset (forget the map), ~clear_region (forget a box), ~save_map (the
+// native map plus one map_server image per published scale, named and cropped as wavog_offline
+// does) and ~flush (the end of the input now: waiting scans, one more publication). Each answers
+// with success and a message; none throws.
 #include <ros/ros.h>
 
 #include <cmath>
+#include <filesystem>
+#include <system_error>
 
 #include "mapping_ros_impl.h"
 #include "save_path.h"
 #include "wavog_mapping/io/image_io.h"
+#include "wavog_mapping/io/map_files.h"
 
 namespace wavog_ros {
 
@@ -34,12 +38,20 @@ void MappingRos::Impl::advertiseServices() {
         guarded("save_map service", nullptr, [&] { onSaveMap(req, res); });
         return true;
       });
+  flush_srv_ = pnh_.advertiseService<std_srvs::Trigger::Request, std_srvs::Trigger::Response>(
+      "flush", [this](std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res) {
+        res.success = false;
+        res.message = "internal error (logged)";
+        guarded("flush service", nullptr, [&] { onFlush(req, res); });
+        return true;
+      });
 }
 
 bool MappingRos::Impl::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   std::lock_guard<std::mutex> lock(mutex_);
   map_.reset();
   publisher_->markAllDirty(map_.resolution());
+  changed_since_publish_ = true;
   ROS_INFO("%s: map reset", pnh_.getNamespace().c_str());
   return true;
 }
@@ -55,6 +67,7 @@ bool MappingRos::Impl::onClearRegion(wavog_mapping::ClearRegion::Request& req,
   std::lock_guard<std::mutex> lock(mutex_);
   map_.clearBox(req.min_x, req.min_y, req.max_x, req.max_y);
   publisher_->touched({req.min_x, req.min_y, req.max_x, req.max_y});
+  changed_since_publish_ = true;
   res.success = true;
   res.message = "cleared";
   return true;
@@ -72,12 +85,18 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
   std::string resolved, refusal;
   if (!resolveSavePath(config_.ros.map_dir, req.path, &resolved, &refusal)) return fail(refusal);
   req.path = resolved;  // below map_dir; relative names resolved under it
-  // <stem>: the path without its extension; images go beside the map file.
-  const std::size_t slash = req.path.find_last_of('/');
-  const std::size_t dot = req.path.find_last_of('.');
-  const std::string stem = (dot != std::string::npos && (slash == std::string::npos || dot > slash))
-                               ? req.path.substr(0, dot)
-                               : req.path;
+  // The folder is created when missing; images go beside the map file as wavog_offline names
+  // them: <stem>_s<scale>.pgm/.yaml, <stem> being the path without its extension.
+  const std::filesystem::path dir = std::filesystem::path(req.path).parent_path();
+  if (!dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) return fail("cannot create the folder '" + dir.string() + "': " + ec.message());
+  }
+  const std::string stem = wavog::pathStem(req.path);
+  // Scans still waiting for tf belong to the saved map (at the end of a bag they would wait
+  // forever).
+  flushPending();
   std::vector<wavog::Raster> rasters;
   std::string refused;  // layers too large for an image
   {
@@ -98,15 +117,15 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
                    std::to_string(box.height()) + " cells)";
       }
       if (size == LayerSize::kOk) {
-        rasters.push_back(map_.exportScale(
-            s, box, s == 0 ? wavog::Aggregation::kMean : config_.ros.scale_aggregation));
+        rasters.push_back(wavog::cropToKnown(map_.exportScale(
+            s, box, s == 0 ? wavog::Aggregation::kMean : config_.ros.scale_aggregation)));
       }
     }
   }
   res.files.push_back(req.path);
   try {
     for (const wavog::Raster& r : rasters) {
-      const std::string base = stem + "_scale_" + std::to_string(r.scale);
+      const std::string base = wavog::scaleFileBase(stem, r.scale);
       res.files.push_back(base + ".pgm");
       res.files.push_back(wavog::writeMapServerMap(base, r));
     }
@@ -122,6 +141,15 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
   }
   ROS_INFO("%s: map saved to %s (+ %zu map_server images)", pnh_.getNamespace().c_str(),
            req.path.c_str(), rasters.size());
+  publishAll();  // the saved map is also the published one
+  return true;
+}
+
+bool MappingRos::Impl::onFlush(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  const std::size_t n = flushPending();
+  publishAll();
+  res.success = true;
+  res.message = std::to_string(n) + " waiting scan(s) integrated with the latest tf; published";
   return true;
 }
 

@@ -9,8 +9,8 @@
 namespace wavog_ros {
 namespace {
 
-/// One number of cfg/Mapping.cfg and where it lives in Config; "scales" (a string) is the only
-/// other run-time parameter.
+/// One number of cfg/Mapping.cfg and where it lives in Config; "scales", "policy" and "init"
+/// (strings) are the other run-time parameters.
 struct NumberField {
   double wavog_mapping::MappingConfig::*reconfigure;
   double& (*in)(Config&);
@@ -37,6 +37,8 @@ wavog_mapping::MappingConfig toReconfigure(const Config& config) {
   wavog_mapping::MappingConfig rc;
   for (const NumberField& f : kNumbers) rc.*f.reconfigure = f.in(c);
   rc.scales = joinScales(c.ros.publish_scales);
+  rc.policy = wavog::toString(c.map.policy.type);
+  rc.init = wavog::toString(c.map.policy.init);
   return rc;
 }
 
@@ -47,9 +49,60 @@ Config withReconfigure(const Config& config, const wavog_mapping::MappingConfig&
   if (!parseScales(rc.scales, &next.ros.publish_scales)) {
     errors->push_back("scales ('" + rc.scales + "') must be comma-separated integers");
   }
+  if (!wavog::fromString(rc.policy, &next.map.policy.type)) {
+    errors->push_back("policy ('" + rc.policy +
+                      "') must be one of: none, max, clamp, forget, clamp_lower, clamp_upper");
+  }
+  if (!wavog::fromString(rc.init, &next.map.policy.init)) {
+    errors->push_back("init ('" + rc.init + "') must be one of: unknown, empty_bound");
+  }
   for (const auto& e : next.map.validate()) errors->push_back(e);
   for (const auto& e : validate(next.ros, next.map)) errors->push_back(e);
   return next;
+}
+
+ReconfigureServer::ReconfigureServer(const ros::NodeHandle& pnh,
+                                     const wavog_mapping::MappingConfig& initial, Apply apply)
+    : pnh_(pnh), current_(initial), apply_(std::move(apply)) {
+  descriptions_pub_ =
+      pnh_.advertise<dynamic_reconfigure::ConfigDescription>("parameter_descriptions", 1, true);
+  descriptions_pub_.publish(wavog_mapping::MappingConfig::__getDescriptionMessage__());
+  updates_pub_ = pnh_.advertise<dynamic_reconfigure::Config>("parameter_updates", 1, true);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    publishLocked();
+  }
+  set_srv_ = pnh_.advertiseService("set_parameters", &ReconfigureServer::onSet, this);
+}
+
+bool ReconfigureServer::onSet(dynamic_reconfigure::Reconfigure::Request& req,
+                              dynamic_reconfigure::Reconfigure::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  wavog_mapping::MappingConfig next = current_;  // parameters not in the request keep their value
+  std::vector<std::string> errors;
+  if (!next.__fromMessage__(req.config)) {
+    errors.emplace_back("the request names a parameter that cfg/Mapping.cfg does not have");
+  } else {
+    errors = apply_(next);
+  }
+  if (errors.empty()) {
+    current_ = next;
+    publishLocked();
+  } else {
+    std::string text;
+    for (const auto& e : errors) text += "\n  " + e;
+    ROS_ERROR("%s: reconfiguration refused, keeping the previous values:%s",
+              pnh_.getNamespace().c_str(), text.c_str());
+  }
+  current_.__toMessage__(res.config);
+  return true;
+}
+
+void ReconfigureServer::publishLocked() {
+  current_.__toServer__(pnh_);
+  dynamic_reconfigure::Config msg;
+  current_.__toMessage__(msg);
+  updates_pub_.publish(msg);
 }
 
 bool parseScales(const std::string& text, std::vector<int>* scales) {

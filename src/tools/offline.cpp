@@ -5,7 +5,6 @@
 // logged (corrected) laser poses are used as they are. The parameters come from the node's YAML
 // through the one loader (wavog_ros::configFromXmlRpc). Writes per scale a PNG, a map_server PGM +
 // YAML, the native map, summary.json and optional snapshots.
-#include <getopt.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/LaserScan.h>
@@ -13,6 +12,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -25,6 +25,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
@@ -35,6 +36,7 @@
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
 #include "wavog_mapping/io/image_io.h"
+#include "wavog_mapping/io/map_files.h"
 #include "wavog_mapping/ros/config.h"
 #include "wavog_mapping/ros/conversions.h"
 #include "wavog_mapping/ros/scan_placement.h"
@@ -43,8 +45,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+using Json = nlohmann::ordered_json;
 
-constexpr int kCropMargin = 2;           // unknown cells kept around the known part of a picture
 constexpr double kTfCacheMargin = 60.0;  // s added to the bag's duration for the tf buffer
 
 struct Options {
@@ -63,32 +65,6 @@ struct Options {
   bool quiet = false;
 };
 
-void usage(std::FILE* out) {
-  std::fprintf(
-      out,
-      "Usage: wavog_offline [options] INPUT\n"
-      "Maps INPUT, a rosbag (LaserScan + /tf, /tf_static) or a CARMEN log (plain or .gz), without\n"
-      "a roscore, and writes to the output folder: map_s<scale>.png (unknown in pale blue),\n"
-      "map_s<scale>.pgm + .yaml (map_server), map.wavog (native map), summary.json.\n\n"
-      "  -o, --out DIR           output folder (default offline_map; created)\n"
-      "  -c, --config FILE       the node's YAML parameters (default: the compiled defaults)\n"
-      "  --policy NAME           none|max|clamp|forget|clamp_lower|clamp_upper (over the YAML;\n"
-      "                          the policy's documented defaults apply to keys the YAML omits)\n"
-      "  --resolution M          finest cell size (over the YAML)\n"
-      "  --scale LIST            scales to write, e.g. 0,2,3 (default: 0 and publish_scales)\n"
-      "  --aggregation mean|max  how a coarse cell summarises its cells (over the YAML)\n"
-      "  --max-scans N           integrate the first N scans only (0: all)\n"
-      "  --topics LIST           bag scan topics (default: the YAML's inputs with --config, else\n"
-      "                          every sensor_msgs/LaserScan topic of the bag)\n"
-      "  --fixed-frame F         map frame (default: the YAML's map_frame); give the scan's own\n"
-      "                          frame to map a bag without tf with the laser held fixed\n"
-      "  --snapshot-every S      also write snapshots/t<seconds>_s<scale>.png every S s of log "
-      "time\n"
-      "  --no-progress           no progress bar\n"
-      "  --quiet                 only errors\n"
-      "  -h, --help\n");
-}
-
 std::vector<int> parseScales(const std::string& text) {
   std::vector<int> scales;
   for (const auto& item : wavog_tools::splitList(text)) {
@@ -98,84 +74,52 @@ std::vector<int> parseScales(const std::string& text) {
   return scales;
 }
 
-bool parseOptions(int argc, char** argv, Options* o) {
-  enum {
-    kPolicy = 1000,
-    kResolution,
-    kScale,
-    kAggregation,
-    kMax,
-    kTopics,
-    kFixed,
-    kSnapshot,
-    kNoProgress,
-    kQuiet
-  };
-  const option longopts[] = {{"out", required_argument, nullptr, 'o'},
-                             {"config", required_argument, nullptr, 'c'},
-                             {"policy", required_argument, nullptr, kPolicy},
-                             {"resolution", required_argument, nullptr, kResolution},
-                             {"scale", required_argument, nullptr, kScale},
-                             {"aggregation", required_argument, nullptr, kAggregation},
-                             {"max-scans", required_argument, nullptr, kMax},
-                             {"topics", required_argument, nullptr, kTopics},
-                             {"fixed-frame", required_argument, nullptr, kFixed},
-                             {"snapshot-every", required_argument, nullptr, kSnapshot},
-                             {"no-progress", no_argument, nullptr, kNoProgress},
-                             {"quiet", no_argument, nullptr, kQuiet},
-                             {"help", no_argument, nullptr, 'h'},
-                             {nullptr, 0, nullptr, 0}};
-  int c = 0;
-  while ((c = getopt_long(argc, argv, "o:c:h", longopts, nullptr)) != -1) {
-    switch (c) {
-      case 'o':
-        o->out = optarg;
-        break;
-      case 'c':
-        o->config = optarg;
-        break;
-      case kPolicy:
-        o->policy = optarg;
-        break;
-      case kResolution:
-        o->resolution = wavog_tools::parseNumber("--resolution", optarg);
-        break;
-      case kScale:
-        o->scales = parseScales(optarg);
-        break;
-      case kAggregation:
-        o->aggregation = optarg;
-        break;
-      case kMax:
-        o->max_scans = static_cast<std::size_t>(wavog_tools::parseInteger("--max-scans", optarg, 0));
-        break;
-      case kTopics:
-        o->topics = wavog_tools::splitList(optarg);
-        break;
-      case kFixed:
-        o->fixed_frame = wavog_tools::stripSlash(optarg);
-        break;
-      case kSnapshot:
-        o->snapshot_every = wavog_tools::parseNumber("--snapshot-every", optarg);
-        break;
-      case kNoProgress:
-        o->progress = false;
-        break;
-      case kQuiet:
+/// What --help says first.
+constexpr const char* kDescription =
+    "Maps INPUT, a rosbag (LaserScan + /tf, /tf_static) or a CARMEN log (plain or .gz), without "
+    "a roscore, and writes to the output folder: map_s<scale>.png (unknown in pale blue), "
+    "map_s<scale>.pgm + .yaml (map_server), map.wavog (native map), summary.json.";
+
+/// The command line of wavog_offline (its --help is generated from these).
+void addOptions(CLI::App* app, Options* o) {
+  app->add_option("-o,--out", o->out, "output folder (created)")->capture_default_str();
+  app->add_option("-c,--config", o->config,
+                  "the node's YAML parameters (default: the compiled defaults)");
+  app->add_option("--policy", o->policy,
+                  "none|max|clamp|forget|clamp_lower|clamp_upper (over the YAML; the policy's "
+                  "documented defaults apply to keys the YAML omits)");
+  wavog_tools::addNumber(app, "--resolution", &o->resolution,
+                         "finest cell size in m (over the YAML; 0: the YAML's)");
+  app->add_option_function<std::string>(
+      "--scale", [o](const std::string& v) { o->scales = parseScales(v); },
+      "scales to write, e.g. 0,2,3 (default: 0 and publish_scales)");
+  app->add_option("--aggregation", o->aggregation,
+                  "mean|max: how a coarse cell summarises its cells (over the YAML)");
+  wavog_tools::addInteger(app, "--max-scans", &o->max_scans, 0,
+                          "integrate the first N scans only (0: all)");
+  app->add_option_function<std::string>(
+      "--topics", [o](const std::string& v) { o->topics = wavog_tools::splitList(v); },
+      "bag scan topics, comma-separated (default: the YAML's inputs with --config, else every "
+      "sensor_msgs/LaserScan topic of the bag)");
+  app->add_option_function<std::string>(
+      "--fixed-frame", [o](const std::string& v) { o->fixed_frame = wavog_tools::stripSlash(v); },
+      "map frame (default: the YAML's map_frame); give the scan's own frame to map a bag "
+      "without tf with the laser held fixed");
+  wavog_tools::addNumber(app, "--snapshot-every", &o->snapshot_every,
+                         "also write snapshots/t<seconds>_s<scale>.png every S s of log time "
+                         "(0: none)");
+  app->add_flag_callback(
+      "--no-progress", [o] { o->progress = false; }, "no progress bar");
+  app->add_flag_callback(
+      "--quiet",
+      [o] {
         o->quiet = true;
         o->progress = false;
-        break;
-      case 'h':
-        usage(stdout);
-        std::exit(0);
-      default:
-        return false;
-    }
-  }
-  if (argc - optind != 1) return false;
-  o->input = argv[optind];
-  if (!(o->snapshot_every >= 0.0)) throw std::invalid_argument("--snapshot-every must be >= 0");
-  return true;
+      },
+      "only errors");
+  app->add_option("input", o->input,
+                  "a rosbag (LaserScan + /tf, /tf_static) or a CARMEN log (plain or .gz)")
+      ->required();
 }
 
 std::string readText(const std::string& path) {
@@ -258,6 +202,11 @@ class Session {
   std::size_t done() const { return done_; }
   std::size_t integrated() const { return integrated_; }
   const std::map<std::string, std::size_t>& dropped() const { return dropped_; }
+  std::size_t droppedTotal() const {
+    std::size_t n = 0;
+    for (const auto& reason : dropped_) n += reason.second;
+    return n;
+  }
   double logDuration() const { return have_first_ ? last_stamp_ - first_stamp_ : 0.0; }
   double integrateSeconds() const { return integrate_s_; }
   std::uint64_t nodesVisited() const { return nodes_visited_; }
@@ -416,6 +365,7 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   Session& s = **session;
   std::string first_tf_error;
   std::set<std::string> scan_frames;
+  std::set<std::string> slash_warned;  // topics whose frame_id had a leading '/'
   wavog::MotionCompensator compensator;
   wavog_ros::PlacementOptions placement_options;
   placement_options.fixed_frame = info.fixed_frame;
@@ -427,9 +377,13 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
       s.skip("not_a_laserscan");
       continue;
     }
-    // Old bags carry frame ids with a leading '/', which tf2 rejects: strip it (the bag's tf
-    // frames were stripped the same way).
-    scan->header.frame_id = wavog_tools::stripSlash(scan->header.frame_id);
+    // Old bags carry frame ids with a leading '/', which tf2 rejects: strip it, saying so once per
+    // topic as the node does (the bag's tf frames were stripped the same way).
+    const std::string received = scan->header.frame_id;
+    if (wavog_ros::stripFrameSlash(&scan->header.frame_id) &&
+        slash_warned.insert(m.getTopic()).second) {
+      info.warnings.push_back(m.getTopic() + ": " + wavog_ros::frameSlashWarning(received));
+    }
     const std::string& frame = scan->header.frame_id;
     scan_frames.insert(frame);
     wavog_ros::DropReason reason = wavog_ros::DropReason::kEmpty;
@@ -510,55 +464,95 @@ InputInfo runCarmen(const Options& o, const wavog_ros::Config& config,
   return info;
 }
 
-/// The raster cropped to its known cells plus a margin (the whole raster if nothing is known).
-wavog::Raster cropToKnown(const wavog::Raster& r) {
-  const std::int64_t w = r.box.width();
-  const std::int64_t h = r.box.height();
-  std::int64_t x0 = w, y0 = h, x1 = -1, y1 = -1;
-  for (std::int64_t y = 0; y < h; ++y) {
-    for (std::int64_t x = 0; x < w; ++x) {
-      if (r.known[static_cast<std::size_t>(y * w + x)]) {
-        x0 = std::min(x0, x);
-        x1 = std::max(x1, x);
-        y0 = std::min(y0, y);
-        y1 = std::max(y1, y);
-      }
-    }
+/// Per scale: a PNG and a map_server map, cropped to the observed part; their entries of
+/// summary.json's "scales".
+Json writeScales(const Options& o, const wavog_ros::Config& config, Session* session) {
+  Json scales = Json::array();
+  wavog::WaveletMap* map = &session->map();
+  for (int scale : session->scales()) {
+    wavog::CellBox box;
+    if (!map->bounds(scale, &box)) break;
+    const wavog::Raster raster =
+        wavog::cropToKnown(map->exportScale(scale, box, config.ros.scale_aggregation));
+    const std::string base = wavog::scaleFileBase("map", scale);  // as ~save_map names them
+    wavog::writePng((fs::path(o.out) / (base + ".png")).string(), wavog::renderRgb(raster));
+    wavog::writeMapServerMap((fs::path(o.out) / base).string(), raster);
+    scales.push_back({{"scale", scale},
+                      {"cell_size_m", raster.cell_size},
+                      {"width", raster.box.width()},
+                      {"height", raster.box.height()},
+                      {"origin", {raster.originX(), raster.originY()}},
+                      {"png", base + ".png"},
+                      {"pgm", base + ".pgm"},
+                      {"yaml", base + ".yaml"}});
   }
-  if (x1 < 0) return r;
-  x0 = std::max<std::int64_t>(0, x0 - kCropMargin);
-  y0 = std::max<std::int64_t>(0, y0 - kCropMargin);
-  x1 = std::min<std::int64_t>(w - 1, x1 + kCropMargin);
-  y1 = std::min<std::int64_t>(h - 1, y1 + kCropMargin);
-  wavog::Raster c = r;
-  c.box = wavog::CellBox{r.box.min_x + x0, r.box.min_y + y0, r.box.min_x + x1 + 1,
-                         r.box.min_y + y1 + 1};
-  const std::int64_t cw = c.box.width();
-  c.log_odds.assign(static_cast<std::size_t>(cw * c.box.height()), 0.0f);
-  c.known.assign(c.log_odds.size(), 0);
-  for (std::int64_t y = y0; y <= y1; ++y) {
-    const std::size_t src = static_cast<std::size_t>(y * w + x0);
-    const std::size_t dst = static_cast<std::size_t>((y - y0) * cw);
-    std::copy_n(r.log_odds.begin() + static_cast<std::ptrdiff_t>(src), cw,
-                c.log_odds.begin() + static_cast<std::ptrdiff_t>(dst));
-    std::copy_n(r.known.begin() + static_cast<std::ptrdiff_t>(src), cw,
-                c.known.begin() + static_cast<std::ptrdiff_t>(dst));
-  }
-  return c;
+  return scales;
 }
 
-int run(const Options& o) {
-  const auto start = Clock::now();
-  {
-    std::ifstream probe(o.input, std::ios::binary);
-    if (fs::is_directory(o.input) || !probe) {
-      throw std::runtime_error(o.input + ": cannot open: " +
-                               (fs::is_directory(o.input) ? std::string("is a directory")
-                                                          : std::string(std::strerror(errno))));
-    }
+/// The first keys of summary.json: what was mapped, how, and what happened to the scans.
+Json describeRun(const Options& o, const wavog_ros::Config& config, const InputInfo& info,
+                 const Session& s) {
+  Json j;
+  j["input"] = o.input;
+  j["input_type"] = info.type;
+  j["config"] = o.config.empty() ? Json() : Json(o.config);
+  j["policy"] = wavog::toString(config.map.policy.type);
+  j["resolution_m"] = config.map.grid.resolution;
+  j["aggregation"] = wavog_ros::toString(config.ros.scale_aggregation);
+  j["fixed_frame"] = info.fixed_frame;
+  j["topics"] = info.topics;
+  j["scans_integrated"] = s.integrated();
+  j["scans_dropped"] = s.droppedTotal();
+  j["dropped_by_reason"] = Json::object();
+  for (const auto& [reason, n] : s.dropped()) j["dropped_by_reason"][reason] = n;
+  j["beams"] = {
+      {"hit", s.beamsHit()}, {"no_return", s.beamsNoReturn()}, {"invalid", s.beamsInvalid()}};
+  j["log_duration_s"] = s.logDuration();
+  return j;
+}
+
+/// Bytes per observed cell of the map (0 for an empty map).
+double bytesPerCell(const wavog::MapStats& stats) {
+  return stats.observed_cells > 0
+             ? static_cast<double>(stats.bytes) / static_cast<double>(stats.observed_cells)
+             : 0.0;
+}
+
+/// summary.json: describeRun's keys, then timings, the map's size and the files written.
+Json summaryOf(const Options& o, const wavog_ros::Config& config, const InputInfo& info,
+               const Session& s, const wavog::MapStats& stats, double loop_s, double wall_s) {
+  Json summary = describeRun(o, config, info, s);
+  summary["wall_time_s"] = wall_s;
+  summary["read_and_integrate_s"] = loop_s;
+  summary["integrate_s"] = s.integrateSeconds();
+  summary["scans_per_s"] = loop_s > 0 ? static_cast<double>(s.integrated()) / loop_s : 0.0;
+  summary["integrate_scans_per_s"] =
+      s.integrateSeconds() > 0 ? static_cast<double>(s.integrated()) / s.integrateSeconds() : 0.0;
+  summary["motion_compensated"] = info.motion_compensated;
+  summary["motion_fallbacks"] = info.motion_fallbacks;
+  summary["nodes_visited_per_scan"] = s.integrated() > 0 ? static_cast<double>(s.nodesVisited()) /
+                                                               static_cast<double>(s.integrated())
+                                                         : 0.0;
+  summary["map"] = {{"blocks", stats.blocks},
+                    {"nodes", stats.nodes},
+                    {"bytes", stats.bytes},
+                    {"observed_cells", stats.observed_cells},
+                    {"bytes_per_observed_cell", bytesPerCell(stats)}};
+  summary["native_map"] = "map.wavog";
+  return summary;
+}
+
+/// The input readable, the configuration loaded (unknown keys warned about), the scales in
+/// range, the output folder made.
+wavog_ros::Config prepare(const Options& o) {
+  if (!(o.snapshot_every >= 0.0)) throw std::invalid_argument("--snapshot-every must be >= 0");
+  if (fs::is_directory(o.input))
+    throw std::runtime_error(o.input + ": cannot open: is a directory");
+  if (!std::ifstream(o.input, std::ios::binary)) {
+    throw std::runtime_error(o.input + ": cannot open: " + std::strerror(errno));
   }
   std::vector<std::string> unknown;
-  const wavog_ros::Config config = loadConfig(o, &unknown);
+  wavog_ros::Config config = loadConfig(o, &unknown);
   if (!unknown.empty() && !o.quiet) {
     std::cerr << "wavog_offline: warning: unknown key(s) in " << o.config << " ignored:";
     for (const auto& k : unknown) std::cerr << " " << k;
@@ -572,7 +566,13 @@ int run(const Options& o) {
     }
   }
   fs::create_directories(o.out);
+  return config;
+}
 
+int run(const Options& o) {
+  ros::Time::init();
+  const auto start = Clock::now();
+  const wavog_ros::Config config = prepare(o);
   std::unique_ptr<Session> session;
   const InputInfo info =
       isBag(o.input) ? runBag(o, config, &session) : runCarmen(o, config, &session);
@@ -582,91 +582,22 @@ int run(const Options& o) {
     for (const auto& w : info.warnings) std::cerr << "wavog_offline: " << w << "\n";
   }
 
-  // Pictures and map_server maps per scale, cropped to the observed part.
-  wavog::WaveletMap& map = s.map();
-  std::ostringstream scales_json;
-  bool first = true;
-  for (int scale : s.scales()) {
-    wavog::CellBox box;
-    if (!map.bounds(scale, &box)) break;
-    const wavog::Raster raster =
-        cropToKnown(map.exportScale(scale, box, config.ros.scale_aggregation));
-    const std::string base = "map_s" + std::to_string(scale);
-    wavog::writePng((fs::path(o.out) / (base + ".png")).string(), wavog::renderRgb(raster));
-    wavog::writeMapServerMap((fs::path(o.out) / base).string(), raster);
-    scales_json << (first ? "" : ",") << "\n    {\"scale\": " << scale
-                << ", \"cell_size_m\": " << wavog_tools::jsonNumber(raster.cell_size)
-                << ", \"width\": " << raster.box.width() << ", \"height\": " << raster.box.height()
-                << ", \"origin\": [" << wavog_tools::jsonNumber(raster.originX()) << ", "
-                << wavog_tools::jsonNumber(raster.originY()) << "], \"png\": \"" << base
-                << ".png\", \"pgm\": \"" << base << ".pgm\", \"yaml\": \"" << base << ".yaml\"}";
-    first = false;
-  }
-  const std::string native = (fs::path(o.out) / "map.wavog").string();
-  map.save(native);
-  const wavog::MapStats stats = map.stats(true);
+  const Json scales = writeScales(o, config, &s);
+  s.map().save((fs::path(o.out) / "map.wavog").string());
+  const wavog::MapStats stats = s.map().stats(true);
   const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
-
-  std::ostringstream json;
-  json << "{\n  \"input\": " << wavog_tools::jsonString(o.input) << ",\n  \"input_type\": \""
-       << info.type << "\""
-       << ",\n  \"config\": " << (o.config.empty() ? "null" : wavog_tools::jsonString(o.config))
-       << ",\n  \"policy\": \"" << wavog::toString(config.map.policy.type) << "\""
-       << ",\n  \"resolution_m\": " << wavog_tools::jsonNumber(config.map.grid.resolution)
-       << ",\n  \"aggregation\": \"" << wavog_ros::toString(config.ros.scale_aggregation) << "\""
-       << ",\n  \"fixed_frame\": " << wavog_tools::jsonString(info.fixed_frame)
-       << ",\n  \"topics\": [";
-  for (std::size_t i = 0; i < info.topics.size(); ++i) {
-    json << (i ? ", " : "") << wavog_tools::jsonString(info.topics[i]);
-  }
-  std::size_t dropped_total = 0;
-  for (const auto& [reason, n] : s.dropped()) dropped_total += n;
-  json << "],\n  \"scans_integrated\": " << s.integrated()
-       << ",\n  \"scans_dropped\": " << dropped_total << ",\n  \"dropped_by_reason\": {";
-  first = true;
-  for (const auto& [reason, n] : s.dropped()) {
-    json << (first ? "" : ", ") << wavog_tools::jsonString(reason) << ": " << n;
-    first = false;
-  }
-  const double per_cell = stats.observed_cells > 0 ? static_cast<double>(stats.bytes) /
-                                                         static_cast<double>(stats.observed_cells)
-                                                   : 0.0;
-  json << "},\n  \"beams\": {\"hit\": " << s.beamsHit() << ", \"no_return\": " << s.beamsNoReturn()
-       << ", \"invalid\": " << s.beamsInvalid() << "}"
-       << ",\n  \"log_duration_s\": " << wavog_tools::jsonNumber(s.logDuration())
-       << ",\n  \"wall_time_s\": " << wavog_tools::jsonNumber(wall_s)
-       << ",\n  \"read_and_integrate_s\": " << wavog_tools::jsonNumber(loop_s)
-       << ",\n  \"integrate_s\": " << wavog_tools::jsonNumber(s.integrateSeconds())
-       << ",\n  \"scans_per_s\": "
-       << wavog_tools::jsonNumber(loop_s > 0 ? static_cast<double>(s.integrated()) / loop_s : 0.0)
-       << ",\n  \"integrate_scans_per_s\": "
-       << wavog_tools::jsonNumber(s.integrateSeconds() > 0
-                                      ? static_cast<double>(s.integrated()) / s.integrateSeconds()
-                                      : 0.0)
-       << ",\n  \"motion_compensated\": " << info.motion_compensated
-       << ",\n  \"motion_fallbacks\": " << info.motion_fallbacks
-       << ",\n  \"nodes_visited_per_scan\": "
-       << wavog_tools::jsonNumber(s.integrated() > 0 ? static_cast<double>(s.nodesVisited()) /
-                                                           static_cast<double>(s.integrated())
-                                                     : 0.0)
-       << ",\n  \"map\": {\"blocks\": " << stats.blocks << ", \"nodes\": " << stats.nodes
-       << ", \"bytes\": " << stats.bytes << ", \"observed_cells\": " << stats.observed_cells
-       << ", \"bytes_per_observed_cell\": " << wavog_tools::jsonNumber(per_cell) << "}"
-       << ",\n  \"native_map\": \"map.wavog\",\n  \"scales\": [" << scales_json.str() << "\n  ]"
-       << ",\n  \"snapshots\": [";
-  for (std::size_t i = 0; i < s.snapshots().size(); ++i) {
-    json << (i ? ", " : "") << wavog_tools::jsonString(s.snapshots()[i]);
-  }
-  json << "],\n  \"read_error\": "
-       << (info.read_error.empty() ? "null" : wavog_tools::jsonString(info.read_error)) << "\n}\n";
-  std::ofstream((fs::path(o.out) / "summary.json").string()) << json.str();
+  Json summary = summaryOf(o, config, info, s, stats, loop_s, wall_s);
+  summary["scales"] = scales;
+  summary["snapshots"] = s.snapshots();
+  summary["read_error"] = info.read_error.empty() ? Json() : Json(info.read_error);
+  wavog_tools::writeJson((fs::path(o.out) / "summary.json").string(), summary);
 
   if (!o.quiet) {
     std::cerr << std::fixed << std::setprecision(2) << "wavog_offline: " << s.integrated()
-              << " scans integrated, " << dropped_total << " dropped, in " << wall_s << " s ("
+              << " scans integrated, " << s.droppedTotal() << " dropped, in " << wall_s << " s ("
               << std::setprecision(0)
               << (loop_s > 0 ? static_cast<double>(s.integrated()) / loop_s : 0.0) << " scans/s); "
-              << stats.bytes << " bytes, " << std::setprecision(3) << per_cell
+              << stats.bytes << " bytes, " << std::setprecision(3) << bytesPerCell(stats)
               << " bytes per observed cell; wrote " << o.out << "/\n";
     for (const auto& [reason, n] : s.dropped()) {
       std::cerr << "wavog_offline:   dropped " << n << " (" << reason << ")\n";
@@ -687,11 +618,5 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options options;
-  return wavog_tools::toolMain(
-      "wavog_offline", [&] { return parseOptions(argc, argv, &options); }, usage,
-      [&] {
-        ros::Time::init();
-        return run(options);
-      });
+  return wavog_tools::toolMain(argc, argv, "wavog_offline", kDescription, addOptions, run);
 }

@@ -6,13 +6,13 @@
 // stats.json / report.md: bytes per observed cell, nodes, the share of observed cells at the
 // policy's bounds and the wall width at half maximum across straight walls.
 // scripts/paper_figures.py draws fig_1_2/1_3/1_4/1_6.png from these files. No ROS.
-#include <sys/stat.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "tool_support.h"
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
@@ -70,11 +71,7 @@ std::string fixed(double v, int digits) {
   return s.str();
 }
 
-void makeDir(const std::string& dir) {
-  if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw std::runtime_error(dir + ": cannot create directory");
-  }
-}
+void makeDir(const std::string& dir) { std::filesystem::create_directories(dir); }
 
 // Writes raster as <stem>.f32 / <stem>.known.u8 / <stem>.json; returns the sidecar's content.
 json writeRaster(const std::string& dir, const std::string& stem, const wavog::Raster& r,
@@ -340,43 +337,60 @@ int run(Options o) {
   return 0;
 }
 
+/// The command line of wavog_paper (its --help is generated from these).
+void addOptions(CLI::App* app, Options* o) {
+  app->add_option("log", o->log, "CARMEN log (default: fr079-corrected.log.gz in the data dir)");
+  app->add_option("-o,--out", o->out_dir, "output folder")->capture_default_str();
+  wavog_tools::addInteger(app, "--max-scans", &o->max_scans, 0,
+                          "map only the first N scans (0: all)");
+  wavog_tools::addInteger(app, "-j,--jobs", &o->jobs, 1, "maps built in parallel (at most 16)");
+  app->add_option_function<std::vector<std::string>>(
+         "--zoom",
+         [o](const std::vector<std::string>& v) {
+           o->zoom.clear();
+           for (const std::string& x : v)
+             o->zoom.push_back(wavog_tools::parseNumber("--zoom", x.c_str()));
+         },
+         "zoom window of fig_1_3 / fig_1_4 (m): X0 Y0 X1 Y1")
+      ->expected(4)
+      ->type_name("NUM");
+  wavog_tools::addNumber(
+      app, "--bound-tolerance", &o->bound_tolerance,
+      "a cell this close (log-odds, in [0, 1]) to a bound counts as at the bound");
+}
+
+/// The defaults that depend on the machine (the data directory) and the range checks.
+void finishOptions(Options* o) {
+  if (o->jobs > 16) throw std::invalid_argument("--jobs must be in [1, 16]");
+  if (!(o->bound_tolerance >= 0.0 && o->bound_tolerance <= 1.0)) {
+    throw std::invalid_argument("--bound-tolerance must be in [0, 1]");
+  }
+  if (o->log.empty()) {
+    const std::string dir = wavog::findDataDir();
+    if (dir.empty()) throw std::runtime_error("no data directory found; set WAVOG_DATA_DIR");
+    o->log = (std::filesystem::path(dir) / "fr079-corrected.log.gz").string();
+  }
+  if (o->zoom.empty()) {
+    o->zoom = {-5.0, -3.0, 5.0, 3.0};
+    o->zoom_is_default = true;
+  }
+  if (!(o->zoom[0] < o->zoom[2] && o->zoom[1] < o->zoom[3])) {
+    throw std::invalid_argument("--zoom: X0 < X1 and Y0 < Y1 required");
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app{
-      "wavog_paper: maps a CARMEN log with the paper's policies and exports the rasters "
-      "and figures of merit behind fig_1_2/1_3/1_4/1_6 (scripts/paper_figures.py)."};
-  app.add_option("log", o.log, "CARMEN log (default: fr079-corrected.log.gz in the data dir)");
-  app.add_option("-o,--out", o.out_dir, "output folder")->capture_default_str();
-  app.add_option("--max-scans", o.max_scans, "map only the first N scans (0: all)")
-      ->capture_default_str();
-  app.add_option("-j,--jobs", o.jobs, "maps built in parallel")
-      ->check(CLI::Range(1, 16))
-      ->capture_default_str();
-  app.add_option("--zoom", o.zoom, "zoom window of fig_1_3 / fig_1_4 (m): X0 Y0 X1 Y1")
-      ->expected(4);
-  app.add_option("--bound-tolerance", o.bound_tolerance,
-                 "a cell this close (log-odds) to a bound counts as at the bound")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
-  try {
-    if (o.log.empty()) {
-      const std::string dir = wavog::findDataDir();
-      if (dir.empty()) throw std::runtime_error("no data directory found; set WAVOG_DATA_DIR");
-      o.log = dir + "/fr079-corrected.log.gz";
-    }
-    if (o.zoom.empty()) {
-      o.zoom = {-5.0, -3.0, 5.0, 3.0};
-      o.zoom_is_default = true;
-    }
-    if (!(o.zoom[0] < o.zoom[2] && o.zoom[1] < o.zoom[3])) {
-      throw std::invalid_argument("--zoom: X0 < X1 and Y0 < Y1 required");
-    }
+  CLI::App app{wavog_tools::wrapText(
+                   "Maps a CARMEN log with the paper's policies and exports the rasters and "
+                   "figures of merit behind fig_1_2/1_3/1_4/1_6 (scripts/paper_figures.py).",
+                   wavog_tools::kHelpWidth),
+               "wavog_paper"};
+  addOptions(&app, &o);
+  return wavog_tools::runTool(&app, argc, argv, [&] {
+    finishOptions(&o);
     return run(o);
-  } catch (const std::exception& e) {
-    std::cerr << "wavog_paper: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }

@@ -7,12 +7,12 @@
 #include <ros/time.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/LaserScan.h>
-#include <sys/stat.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -29,8 +29,6 @@
 #include "wavog_mapping/sim/world_file.h"
 
 namespace {
-
-using wavog_tools::parseNumber;
 
 using wavog::sim::GridWindow;
 using wavog::sim::LaserParams;
@@ -55,89 +53,80 @@ struct Options {
   double truth_every = 10.0;
   std::string write_world;  // write the world as YAML here
   // Error of the /tf poses (the lasers measure from the true pose).
-  wavog::sim::PoseNoiseParams pose_noise;
+  wavog::sim::PoseNoiseParams pose_noise;  // its seed: poseNoise()
+  long pose_seed = -1;                     // < 0: --seed
 };
 
-void usage(std::ostream& out) {
-  out << "usage: wavog_simulate [options]\n"
-         "Simulates a vehicle with planar lasers (default: the car park with four LMS-291) and\n"
-         "writes a rosbag: one LaserScan topic per laser, /tf (map -> base_link), /tf_static.\n\n"
-         "  --world FILE          YAML/JSON world (default: the built-in car park)\n"
-         "  --out BAG             output bag (default scenario.bag)\n"
-         "  --seed N              noise seed (default 1); same seed, same bag\n"
-         "  --duration S          simulated seconds (default: the world's, 60 for the car park)\n"
-         "  --noise SIGMA         range noise standard deviation (m) for every laser\n"
-         "  --dropout P           NaN dropout probability per beam for every laser\n"
-         "  --map-frame F         fixed frame of /tf (default map)\n"
-         "  --base-frame F        vehicle frame (default base_link)\n"
-         "  --truth-dir DIR       write ground truth there: world.yaml, truth_<t>s.png/.pgm/.yaml\n"
-         "  --truth-resolution R  ground-truth cell size (m, default 0.1)\n"
-         "  --truth-every S       ground-truth snapshot period (s, default 10)\n"
-         "  --write-world FILE    write the world as YAML (e.g. to edit the default) and go on\n"
-         "  --pose-sigma-xy M     per-scan Gaussian error of the /tf position, x and y (m, 0)\n"
-         "  --pose-sigma-yaw-deg D   per-scan Gaussian error of the /tf heading (deg, 0)\n"
-         "  --pose-drift-x V, --pose-drift-y V   slow linear drift of the /tf position (m/s, 0)\n"
-         "  --pose-drift-yaw-deg W   slow linear drift of the /tf heading (deg/s, 0)\n"
-         "  --pose-seed N         seed of the pose errors (default: --seed)\n"
-         "                        (the lasers always measure from the true pose)\n";
+/// An angle option given in degrees, kept in radians (read whole, as addNumber).
+void addDegrees(CLI::App* app, const std::string& name, double* radians, const std::string& help) {
+  std::ostringstream shown;
+  shown << *radians * 180.0 / M_PI;
+  app->add_option_function<std::string>(
+         name,
+         [name, radians](const std::string& v) {
+           *radians = wavog_tools::parseNumber(name, v.c_str()) * M_PI / 180.0;
+         },
+         help)
+      ->type_name("NUM")
+      ->default_str(shown.str());
 }
 
-Options parseArgs(int argc, char** argv) {
-  Options o;
-  std::uint64_t pose_seed = 0;
-  bool pose_seed_set = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      usage(std::cout);
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + a);
-    const char* v = argv[++i];
-    if (a == "--world")
-      o.world_file = v;
-    else if (a == "--out")
-      o.bag = v;
-    else if (a == "--seed")
-      o.seed = static_cast<std::uint64_t>(parseNumber(a, v));
-    else if (a == "--duration")
-      o.duration = parseNumber(a, v);
-    else if (a == "--noise")
-      o.noise_sigma = parseNumber(a, v);
-    else if (a == "--dropout")
-      o.dropout = parseNumber(a, v);
-    else if (a == "--map-frame")
-      o.map_frame = v;
-    else if (a == "--base-frame")
-      o.base_frame = v;
-    else if (a == "--truth-dir")
-      o.truth_dir = v;
-    else if (a == "--truth-resolution")
-      o.truth_resolution = parseNumber(a, v);
-    else if (a == "--truth-every")
-      o.truth_every = parseNumber(a, v);
-    else if (a == "--write-world")
-      o.write_world = v;
-    else if (a == "--pose-sigma-xy")
-      o.pose_noise.sigma_xy_m = parseNumber(a, v);
-    else if (a == "--pose-sigma-yaw-deg")
-      o.pose_noise.sigma_yaw_rad = parseNumber(a, v) * M_PI / 180.0;
-    else if (a == "--pose-drift-x")
-      o.pose_noise.drift_x_m_per_s = parseNumber(a, v);
-    else if (a == "--pose-drift-y")
-      o.pose_noise.drift_y_m_per_s = parseNumber(a, v);
-    else if (a == "--pose-drift-yaw-deg")
-      o.pose_noise.drift_yaw_rad_per_s = parseNumber(a, v) * M_PI / 180.0;
-    else if (a == "--pose-seed")
-      pose_seed = static_cast<std::uint64_t>(parseNumber(a, v)), pose_seed_set = true;
-    else
-      throw std::invalid_argument("unknown option: " + a);
-  }
+/// The /tf pose error options (the lasers always measure from the true pose).
+void addPoseNoiseOptions(CLI::App* app, Options* o) {
+  wavog_tools::addNumber(app, "--pose-sigma-xy", &o->pose_noise.sigma_xy_m,
+                         "per-scan Gaussian error of the /tf position, x and y (m)");
+  addDegrees(app, "--pose-sigma-yaw-deg", &o->pose_noise.sigma_yaw_rad,
+             "per-scan Gaussian error of the /tf heading (deg)");
+  wavog_tools::addNumber(app, "--pose-drift-x", &o->pose_noise.drift_x_m_per_s,
+                         "slow linear drift of the /tf position along x (m/s)");
+  wavog_tools::addNumber(app, "--pose-drift-y", &o->pose_noise.drift_y_m_per_s,
+                         "slow linear drift of the /tf position along y (m/s)");
+  addDegrees(app, "--pose-drift-yaw-deg", &o->pose_noise.drift_yaw_rad_per_s,
+             "slow linear drift of the /tf heading (deg/s)");
+  wavog_tools::addInteger(app, "--pose-seed", &o->pose_seed, 0,
+                          "seed of the pose errors (default: --seed)")
+      ->default_str("--seed");
+}
+
+/// The pose error of the /tf poses, its seed --pose-seed or else --seed.
+wavog::sim::PoseNoiseParams poseNoise(const Options& o) {
+  wavog::sim::PoseNoiseParams p = o.pose_noise;
+  p.seed = o.pose_seed >= 0 ? static_cast<std::uint64_t>(o.pose_seed) : o.seed;
+  return p;
+}
+
+/// What --help says first.
+constexpr const char* kDescription =
+    "Simulates a vehicle with planar lasers (default: the car park with four LMS-291) and writes "
+    "a rosbag: one LaserScan topic per laser, /tf (map -> base_link), /tf_static.";
+
+/// The command line of wavog_simulate (its --help is generated from these).
+void addOptions(CLI::App* app, Options* o) {
+  app->add_option("--world", o->world_file, "YAML/JSON world (default: the built-in car park)");
+  app->add_option("--out", o->bag, "output bag")->capture_default_str();
+  wavog_tools::addInteger(app, "--seed", &o->seed, 0, "noise seed; same seed, same bag");
+  wavog_tools::addNumber(app, "--duration", &o->duration,
+                         "simulated seconds (< 0: the world's, 60 for the car park)");
+  wavog_tools::addNumber(app, "--noise", &o->noise_sigma,
+                         "range noise standard deviation (m) for every laser (< 0: each laser's)");
+  wavog_tools::addNumber(app, "--dropout", &o->dropout,
+                         "NaN dropout probability per beam for every laser (< 0: each laser's)");
+  app->add_option("--map-frame", o->map_frame, "fixed frame of /tf")->capture_default_str();
+  app->add_option("--base-frame", o->base_frame, "vehicle frame")->capture_default_str();
+  app->add_option("--truth-dir", o->truth_dir,
+                  "write ground truth there: world.yaml, truth_<t>s.png/.pgm/.yaml");
+  wavog_tools::addNumber(app, "--truth-resolution", &o->truth_resolution,
+                         "ground-truth cell size (m)");
+  wavog_tools::addNumber(app, "--truth-every", &o->truth_every, "ground-truth snapshot period (s)");
+  app->add_option("--write-world", o->write_world,
+                  "write the world as YAML (e.g. to edit the default) and go on");
+  addPoseNoiseOptions(app, o);
+}
+
+void validate(const Options& o) {
   if (!(o.truth_resolution > 0.0)) throw std::invalid_argument("--truth-resolution must be > 0");
   if (!(o.truth_every > 0.0)) throw std::invalid_argument("--truth-every must be > 0");
-  o.pose_noise.seed = pose_seed_set ? pose_seed : o.seed;
-  for (const std::string& e : o.pose_noise.validate()) throw std::invalid_argument(e);
-  return o;
+  for (const std::string& e : poseNoise(o).validate()) throw std::invalid_argument(e);
 }
 
 geometry_msgs::TransformStamped transformMsg(const std::string& parent, const std::string& child,
@@ -176,10 +165,9 @@ std::string absoluteTopic(const std::string& topic) {
 }
 
 void writeTruth(const World& world, const Options& o) {
-  if (mkdir(o.truth_dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw std::runtime_error(o.truth_dir + ": cannot create directory");
-  }
-  std::ofstream(o.truth_dir + "/world.yaml") << wavog::sim::worldToYaml(world);
+  std::filesystem::create_directories(o.truth_dir);
+  std::ofstream(std::filesystem::path(o.truth_dir) / "world.yaml")
+      << wavog::sim::worldToYaml(world);
   const GridWindow window =
       GridWindow::covering(world.region_min, world.region_max, o.truth_resolution);
   for (int k = 0; k * o.truth_every < world.duration + 1e-9; ++k) {
@@ -194,14 +182,15 @@ void writeTruth(const World& world, const Options& o) {
     raster.known.assign(occ.size(), 1);
     for (std::size_t i = 0; i < occ.size(); ++i) raster.log_odds[i] = occ[i] ? 20.0f : -20.0f;
     std::ostringstream base;
-    base << o.truth_dir << "/truth_" << std::fixed << std::setprecision(1) << std::setw(6)
-         << std::setfill('0') << t << "s";
+    base << (std::filesystem::path(o.truth_dir) / "truth_").string() << std::fixed
+         << std::setprecision(1) << std::setw(6) << std::setfill('0') << t << "s";
     wavog::writePng(base.str() + ".png", wavog::renderGrey(raster));
     wavog::writeMapServerMap(base.str(), raster);
   }
 }
 
 int run(const Options& o) {
+  validate(o);
   World world =
       o.world_file.empty() ? wavog::sim::defaultWorld() : wavog::sim::loadWorld(o.world_file);
   if (o.duration > 0.0) world.duration = o.duration;
@@ -230,13 +219,14 @@ int run(const Options& o) {
   (*latched)["callerid"] = "/wavog_simulate";
   bag.write("/tf_static", t0, statics, latched);
 
+  const wavog::sim::PoseNoiseParams noise = poseNoise(o);
   std::vector<std::size_t> per_laser(world.vehicle.lasers.size(), 0);
   SimScan scan;
   std::size_t done = 0;
   while (sim.next(&scan)) {
     const ros::Time stamp = t0 + ros::Duration(scan.stamp);
     tf2_msgs::TFMessage tf;
-    const wavog::Pose2 told = wavog::sim::withPoseError(world, scan, o.pose_noise).vehicle_pose;
+    const wavog::Pose2 told = wavog::sim::withPoseError(world, scan, noise).vehicle_pose;
     tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame, told, stamp));
     bag.write("/tf", stamp, tf);
     const LaserParams& laser = world.vehicle.lasers[static_cast<std::size_t>(scan.laser)];
@@ -270,14 +260,5 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(parseArgs(argc, argv));
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "wavog_simulate: " << e.what() << "\n";
-    usage(std::cerr);
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "wavog_simulate: " << e.what() << "\n";
-    return 1;
-  }
+  return wavog_tools::toolMain(argc, argv, "wavog_simulate", kDescription, addOptions, run);
 }

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -181,40 +182,11 @@ void ProgressBar::draw(std::size_t done, bool final_line) {
   std::fflush(stderr);
 }
 
-std::string jsonString(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(c));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
-std::string jsonNumber(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream s;
-  s << std::setprecision(10) << v;
-  return s.str();
+void writeJson(const std::string& path, const nlohmann::ordered_json& json) {
+  std::ofstream out(path, std::ios::trunc);
+  out << json.dump(2) << "\n";
+  out.close();
+  if (!out) throw std::runtime_error(path + ": cannot write");
 }
 
 std::vector<std::string> splitList(const std::string& text) {
@@ -231,20 +203,6 @@ std::vector<std::string> splitList(const std::string& text) {
 
 std::string stripSlash(const std::string& frame) {
   return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
-}
-
-int toolMain(const char* name, const std::function<bool()>& parse, void (*usage)(std::FILE*),
-             const std::function<int()>& run) {
-  try {
-    if (!parse()) {
-      usage(stderr);
-      return 2;
-    }
-    return run();
-  } catch (const std::exception& e) {
-    std::cerr << name << ": error: " << e.what() << "\n";
-    return 1;
-  }
 }
 
 double parseNumber(const std::string& flag, const char* text) {
@@ -266,6 +224,63 @@ long parseInteger(const std::string& flag, const char* text, long min_value) {
                                 ": '" + text + "'");
   }
   return v;
+}
+
+std::string wrapText(const std::string& text, std::size_t width) {
+  std::istringstream words(text);
+  std::string word;
+  std::string out;
+  std::size_t line = 0;
+  while (words >> word) {
+    if (line > 0 && line + 1 + word.size() > width) {
+      out += "\n";
+      line = 0;
+    } else if (line > 0) {
+      out += " ";
+      ++line;
+    }
+    out += word;
+    line += word.size();
+  }
+  return out;
+}
+
+std::string longName(const std::string& names) {
+  const std::size_t comma = names.find_last_of(',');
+  return comma == std::string::npos ? names : names.substr(comma + 1);
+}
+
+CLI::Option* addNumber(CLI::App* app, const std::string& names, double* value,
+                       const std::string& help) {
+  const std::string flag = longName(names);
+  std::ostringstream shown;
+  shown << *value;
+  return app
+      ->add_option_function<std::string>(
+          names,
+          [flag, value](const std::string& text) { *value = parseNumber(flag, text.c_str()); },
+          help)
+      ->type_name("NUM")
+      ->default_str(shown.str());
+}
+
+int runTool(CLI::App* app, int argc, char** argv, const std::function<int()>& run) {
+  const std::string name = app->get_name();
+  try {
+    try {
+      app->parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+      std::cout << app->help();
+      return 0;
+    } catch (const CLI::ParseError& e) {
+      std::cerr << name << ": error: " << e.what() << "\n" << app->help();
+      return 2;
+    }
+    return run();
+  } catch (const std::exception& e) {
+    std::cerr << name << ": error: " << e.what() << "\n";
+    return 1;
+  }
 }
 
 }  // namespace wavog_tools

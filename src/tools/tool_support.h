@@ -1,14 +1,18 @@
-// Shared pieces of the command-line tools (wavog_log2bag, wavog_offline): the plan of a CARMEN log
-// (lasers, their frames and topics, duplicates), time stamp repair, planar pose algebra, a
-// terminal progress bar and small text helpers. No ROS. Not thread-safe.
+// Shared pieces of the command-line tools (wavog_log2bag, wavog_offline, wavog_simulate,
+// wavog_evaluate, wavog_compare): the plan of a CARMEN log (lasers, their frames and topics,
+// duplicates), time stamp repair, planar pose algebra, a terminal progress bar, the command line
+// (CLI11: strict numbers, one main()), JSON files (nlohmann-json) and small text helpers. No ROS.
+// Not thread-safe.
 #ifndef WAVOG_MAPPING_TOOLS_TOOL_SUPPORT_H_
 #define WAVOG_MAPPING_TOOLS_TOOL_SUPPORT_H_
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -111,19 +115,13 @@ class ProgressBar {
   std::size_t next_decile_ = 1;
 };
 
-/// Text as a JSON string literal (quotes included).
-std::string jsonString(const std::string& text);
-/// A finite double as JSON (non-finite: null).
-std::string jsonNumber(double v);
+/// Writes `json` to `path`, indented by two, with a final newline; throws std::runtime_error naming
+/// the file when it cannot be written.
+void writeJson(const std::string& path, const nlohmann::ordered_json& json);
 /// "a,b,c" -> {"a", "b", "c"} (empty fields dropped).
 std::vector<std::string> splitList(const std::string& text);
 /// Strips one leading '/' (tf2 rejects frame ids that start with one).
 std::string stripSlash(const std::string& frame);
-
-/// The main() of wavog_log2bag and wavog_offline: `parse` (false: `usage` on stderr, status 2),
-/// then `run`'s status; any exception prints "<name>: error: <what>" and gives status 1.
-int toolMain(const char* name, const std::function<bool()>& parse, void (*usage)(std::FILE*),
-             const std::function<int()>& run);
 
 /// A command-line number: the whole of `text` must be a finite number, else
 /// std::invalid_argument("<flag>: not a number: '<text>'").
@@ -131,6 +129,53 @@ double parseNumber(const std::string& flag, const char* text);
 /// A command-line whole number >= min_value: std::invalid_argument("<flag>: not a whole number
 /// >= <min>: '<text>'") otherwise (trailing characters, fractions and overflow included).
 long parseInteger(const std::string& flag, const char* text, long min_value);
+
+/// The long name of a CLI11 option list: "-o,--out" -> "--out".
+std::string longName(const std::string& names);
+
+/// An option whose value is read whole by parseNumber (`--rate 0.05x` is an error naming the
+/// option, exit status 1); its current value is the default shown by --help.
+CLI::Option* addNumber(CLI::App* app, const std::string& names, double* value,
+                       const std::string& help);
+
+/// An option whose value is read whole by parseInteger(min_value); the default as addNumber.
+template <typename T>
+CLI::Option* addInteger(CLI::App* app, const std::string& names, T* value, long min_value,
+                        const std::string& help) {
+  const std::string flag = longName(names);
+  return app
+      ->add_option_function<std::string>(
+          names,
+          [flag, value, min_value](const std::string& text) {
+            *value = static_cast<T>(parseInteger(flag, text.c_str(), min_value));
+          },
+          help)
+      ->type_name("INT")
+      ->default_str(std::to_string(*value));
+}
+
+/// Width of the tools' --help descriptions.
+constexpr std::size_t kHelpWidth = 96;
+
+/// The main() of every tool: parses the command line with `app` (--help: the generated help on
+/// stdout, status 0; a usage error: "<name>: error: <what>" and the help on stderr, status 2),
+/// then returns `run`'s status; any exception (a bad number included) prints
+/// "<name>: error: <what>" and gives status 1.
+int runTool(CLI::App* app, int argc, char** argv, const std::function<int()>& run);
+
+/// `text` broken at spaces into lines of at most `width` characters (longer words stay whole).
+std::string wrapText(const std::string& text, std::size_t width);
+
+/// A whole main(): `add_options` declares the options of a default `Options` on an app called
+/// `name` (its --help shows `description`), then runTool with `run`.
+template <typename Options>
+int toolMain(int argc, char** argv, const char* name, const char* description,
+             void (*add_options)(CLI::App*, Options*), int (*run)(const Options&)) {
+  Options options;
+  CLI::App app{wrapText(description, kHelpWidth), name};
+  add_options(&app, &options);
+  return runTool(&app, argc, argv, [&] { return run(options); });
+}
 
 }  // namespace wavog_tools
 

@@ -110,6 +110,27 @@ inline sensor_msgs::LaserScan::Ptr scanOf(const Sensor& s, const ros::Time& stam
   return scan;
 }
 
+/// A full-circle scan (720 beams, 0.5 deg) of the room taken from (ox, oy) with yaw 0, each range
+/// shortened by `shrink` m, in frame `frame` (beams untimed: no motion compensation).
+inline sensor_msgs::LaserScan::Ptr circleScan(const std::string& frame, const ros::Time& stamp,
+                                              double ox, double oy, double shrink = 0.0) {
+  auto scan = boost::make_shared<sensor_msgs::LaserScan>();
+  scan->header.frame_id = frame;
+  scan->header.stamp = stamp;
+  constexpr int kCircleBeams = 720;
+  scan->angle_min = static_cast<float>(-kPi);
+  scan->angle_increment = static_cast<float>(kPi / 360);
+  scan->angle_max =
+      static_cast<float>(scan->angle_min + (kCircleBeams - 1) * scan->angle_increment);
+  scan->range_min = 0.1f;
+  scan->range_max = 80.0f;
+  for (int i = 0; i < kCircleBeams; ++i) {
+    const double a = scan->angle_min + i * static_cast<double>(scan->angle_increment);
+    scan->ranges.push_back(static_cast<float>(castRay(ox, oy, std::cos(a), std::sin(a)) - shrink));
+  }
+  return scan;
+}
+
 /// Value of the grid cell holding map point (x, y); -2 when outside the grid.
 inline int cellAt(const nav_msgs::OccupancyGrid& g, double x, double y) {
   const double r = g.info.resolution;

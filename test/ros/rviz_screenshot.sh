@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# make rviz-check: runs test/rviz_check.launch under Xvfb, grabs the screen after the map arrived,
+# make rviz-check: simulates 40 s of the demo's car park, plays it through test/rviz_check.launch
+# (playback.launch, config/lms291_x4.yaml, rviz/wavog.rviz) under Xvfb, grabs the screen,
 # writes the screenshot to $1 and checks that the map is drawn: in rviz's "map" colour scheme
 # unknown cells are grey-green (112, 137, 134) and free cells white; the view must show both.
 set -euo pipefail
 out=${1:?usage: rviz_screenshot.sh OUT.png}
 mkdir -p "$(dirname "$out")"
 display=:97
+export WAVOG_RVIZ_BAG="${out%.png}_scenario.bag"
+"$(catkin_find --first-only --libexec wavog_mapping wavog_simulate)" --duration 40 --out "$WAVOG_RVIZ_BAG" >/dev/null
 Xvfb $display -screen 0 1280x800x24 -nolisten tcp >/dev/null 2>&1 &
 xvfb_pid=$!
 export DISPLAY=$display LIBGL_ALWAYS_SOFTWARE=1

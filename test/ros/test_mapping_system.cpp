@@ -20,10 +20,9 @@
 namespace {
 
 /// Expected geometry (test parameters: resolution 0.1, block_levels 6, scales 2 3 4): the room
-/// touches blocks -1 and 0 on each axis, so every layer covers [-6.4, 6.4)^2.
+/// touches blocks -1 and 0 on each axis, [-6.4, 6.4)^2, but a layer covers only the room.
 constexpr double kResolution = 0.1;
 constexpr double kExtent = 12.8;
-constexpr double kOrigin = -6.4;
 
 class Recorder {
  public:
@@ -98,17 +97,26 @@ void checkLayer(const std::string& topic, int scale) {
   const double res = kResolution * (1 << scale);
   EXPECT_EQ(g->header.frame_id, "map");
   EXPECT_NEAR(g->info.resolution, res, 1e-6);
-  EXPECT_NEAR(g->info.width * res, kExtent, 1e-6);
-  EXPECT_NEAR(g->info.height * res, kExtent, 1e-6);
-  EXPECT_NEAR(g->info.origin.position.x, kOrigin, 1e-6);
-  EXPECT_NEAR(g->info.origin.position.y, kOrigin, 1e-6);
+  // The grid covers what was observed, the room (7.9 m x 5.9 m) and the occupied band of its
+  // walls, in whole cells of the layer: not the 12.8 m blocks that hold it.
+  const double x0 = g->info.origin.position.x, y0 = g->info.origin.position.y;
+  const double w = g->info.width * res, h = g->info.height * res;
+  EXPECT_LE(x0, -room::kHalfX + 1e-6);
+  EXPECT_GE(x0, -room::kHalfX - 0.1 - res - 1e-6);
+  EXPECT_LE(y0, -room::kHalfY + 1e-6);
+  EXPECT_GE(y0, -room::kHalfY - 0.1 - res - 1e-6);
+  EXPECT_GE(x0 + w, room::kHalfX - 1e-6);
+  EXPECT_LE(x0 + w, room::kHalfX + 0.1 + res + 1e-6);
+  EXPECT_GE(y0 + h, room::kHalfY - 1e-6);
+  EXPECT_LE(y0 + h, room::kHalfY + 0.1 + res + 1e-6);
+  EXPECT_LT(w, kExtent);
   EXPECT_EQ(g->info.origin.orientation.w, 1.0);
   ASSERT_EQ(g->data.size(), static_cast<std::size_t>(g->info.width) * g->info.height);
   EXPECT_GT(room::cellAt(*g, room::kOccX, room::kOccY), 65) << "wall cell not occupied";
   const int free_value = room::cellAt(*g, room::kFreeX, room::kFreeY);
   EXPECT_GE(free_value, 0) << "free cell unknown";
   EXPECT_LT(free_value, 35) << "free cell not free";
-  EXPECT_EQ(room::cellAt(*g, room::kUnkX, room::kUnkY), -1) << "cell outside the room not unknown";
+  EXPECT_EQ(room::cellAt(*g, room::kUnkX, room::kUnkY), -2) << "grid reaches beyond the room";
   for (std::int8_t v : g->data) {
     ASSERT_TRUE(v == -1 || (v >= 0 && v <= 100)) << static_cast<int>(v);
   }
@@ -173,8 +181,8 @@ TEST(MappingSystem, MapUpdatesLieInsideTheFullGrid) {
   EXPECT_GE(u->y, 0);
   EXPECT_LE(u->x + static_cast<int>(u->width), static_cast<int>(g->info.width));
   EXPECT_LE(u->y + static_cast<int>(u->height), static_cast<int>(g->info.height));
-  // The scanners see the whole room: the update is smaller than the grid, yet covers the room.
-  EXPECT_LT(static_cast<std::size_t>(u->width) * u->height, g->data.size());
+  // The scanners see the whole room, and the grid is the room: the update is at most the grid.
+  EXPECT_LE(static_cast<std::size_t>(u->width) * u->height, g->data.size());
 }
 
 TEST(MappingSystem, DiagnosticsPerInputAndMapper) {

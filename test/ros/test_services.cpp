@@ -92,11 +92,40 @@ TEST_F(Services, SaveMapWritesNativeAndMapServerFiles) {
   ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", srv));
   EXPECT_TRUE(srv.response.success) << srv.response.message;
   EXPECT_TRUE(exists(kMapFile));
+  // wavog_offline's names: <stem>_s<scale>.
   for (const char* s : {"0", "2", "3", "4"}) {
-    EXPECT_TRUE(exists(kDir + "/room_scale_" + s + ".pgm")) << s;
-    EXPECT_TRUE(exists(kDir + "/room_scale_" + s + ".yaml")) << s;
+    EXPECT_TRUE(exists(kDir + "/room_s" + s + ".pgm")) << s;
+    EXPECT_TRUE(exists(kDir + "/room_s" + s + ".yaml")) << s;
   }
   EXPECT_EQ(srv.response.files.size(), 9u);
+  // The PGM is cropped as wavog_offline crops it: the room (7.9 m x 5.9 m at 0.1 m) plus at most
+  // two unknown cells a side, not the 6.4 m blocks that hold it.
+  {
+    std::ifstream pgm(kDir + "/room_s0.pgm", std::ios::binary);
+    std::string magic;
+    int w = 0, h = 0;
+    pgm >> magic >> w >> h;
+    EXPECT_EQ(magic, "P5");
+    EXPECT_LE(w, 80 + 4);
+    EXPECT_LE(h, 60 + 4);
+    EXPECT_GE(w, 40);  // what laser_1 sees of the room
+    EXPECT_GE(h, 30);
+  }
+
+  // A missing folder is created.
+  wavog_mapping::SaveMap nested;
+  nested.request.path = kDir + "/new/sub/room.wavog";
+  ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", nested));
+  EXPECT_TRUE(nested.response.success) << nested.response.message;
+  EXPECT_TRUE(exists(kDir + "/new/sub/room.wavog"));
+  EXPECT_TRUE(exists(kDir + "/new/sub/room_s0.pgm"));
+  // A folder that cannot be created: a clear refusal.
+  wavog_mapping::SaveMap blocked;
+  blocked.request.path = kMapFile + "/below_a_file/room.wavog";
+  ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", blocked));
+  EXPECT_FALSE(blocked.response.success);
+  EXPECT_NE(blocked.response.message.find("cannot create the folder"), std::string::npos)
+      << blocked.response.message;
 
   // A node restarted with map_file publishes the same map (same geometry, same values).
   std::string output;
@@ -203,16 +232,31 @@ TEST_F(Services, PublishWindowLimitsTheGrid) {
   node.join();
   std::lock_guard<std::mutex> lock(m);
   ASSERT_TRUE(window) << output;
-  const double w = window->info.width * window->info.resolution;
-  const double h = window->info.height * window->info.resolution;
-  EXPECT_GE(w, 2.0 - 1e-6);
-  EXPECT_LE(w, 2.2 + 1e-6);
-  EXPECT_GE(h, 2.0 - 1e-6);
-  EXPECT_LE(h, 2.2 + 1e-6);
-  EXPECT_LE(window->info.origin.position.x, 0.3 - 1.0 + 1e-6);
-  EXPECT_GE(window->info.origin.position.x, 0.3 - 1.1 - 1e-6);
-  EXPECT_LE(window->info.origin.position.y, 0.2 - 1.0 + 1e-6);
-  EXPECT_GE(window->info.origin.position.y, 0.2 - 1.1 - 1e-6);
+  // The window clipped to what was observed: inside the window (to the cell), and every border
+  // row and column of the grid holds an observed cell. laser_1 sees only the front-left part of
+  // the window, so the grid is smaller than the window.
+  const nav_msgs::OccupancyGrid& g = *window;
+  const double w = g.info.width * g.info.resolution;
+  const double h = g.info.height * g.info.resolution;
+  const double x0 = g.info.origin.position.x, y0 = g.info.origin.position.y;
+  EXPECT_GE(x0, 0.3 - 1.1 - 1e-6);
+  EXPECT_GE(y0, 0.2 - 1.1 - 1e-6);
+  EXPECT_LE(x0 + w, 0.3 + 1.1 + 1e-6);
+  EXPECT_LE(y0 + h, 0.2 + 1.1 + 1e-6);
+  EXPECT_LT(w * h, 2.0 * 2.0);
+  const auto known = [&g](std::uint32_t x, std::uint32_t y) {
+    return g.data[static_cast<std::size_t>(y) * g.info.width + x] != -1;
+  };
+  bool left = false, right = false, bottom = false, top = false;
+  for (std::uint32_t y = 0; y < g.info.height; ++y) {
+    left = left || known(0, y);
+    right = right || known(g.info.width - 1, y);
+  }
+  for (std::uint32_t x = 0; x < g.info.width; ++x) {
+    bottom = bottom || known(x, 0);
+    top = top || known(x, g.info.height - 1);
+  }
+  EXPECT_TRUE(left && right && bottom && top) << "the grid carries unobserved border lines";
 }
 
 TEST_F(Services, DynamicReconfigureValidatesAndApplies) {
@@ -266,6 +310,26 @@ TEST_F(Services, DynamicReconfigureValidatesAndApplies) {
   ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", bad));
   EXPECT_EQ(value(bad.response.config, "scales"), "2,5");
   EXPECT_EQ(value(bad.response.config, "gamma"), std::to_string(0.5));
+
+  // Out of the .cfg range: refused, not clamped to the range (odd_occ must be > 0).
+  dynamic_reconfigure::Reconfigure negative;
+  dynamic_reconfigure::DoubleParameter odd_occ;
+  odd_occ.name = "odd_occ";
+  odd_occ.value = -1.0;
+  negative.request.config.doubles.push_back(odd_occ);
+  gamma.value = 0.9;
+  negative.request.config.doubles.push_back(gamma);
+  ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", negative));
+  EXPECT_EQ(value(negative.response.config, "odd_occ"), std::to_string(3.5));
+  EXPECT_EQ(value(negative.response.config, "gamma"), std::to_string(0.5));
+  // An unknown policy name: refused.
+  dynamic_reconfigure::Reconfigure policy;
+  dynamic_reconfigure::StrParameter name;
+  name.name = "policy";
+  name.value = "forgett";
+  policy.request.config.strs.push_back(name);
+  ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", policy));
+  EXPECT_EQ(value(policy.response.config, "policy"), "forget");
 }
 
 TEST_F(Services, SilentLaserIsReportedStale) {

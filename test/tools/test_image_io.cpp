@@ -1,13 +1,18 @@
 // Tests of the image writers: raster rendering (orientation, grey levels, unknown colour), PNG and
-// PGM round trips through the readers, the map_server YAML, and the errors. gtest + wavog_io only.
+// PGM round trips, the map_server YAML, and the errors. The PNGs writePng makes are decoded by an
+// independent decoder, Python's PIL (its own PNG reader, not libpng), so that a mistake made the
+// same way in our writer and reader cannot pass. gtest + wavog_io (+ python3-pil at run time).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "wavog_mapping/io/image_io.h"
 
@@ -49,6 +54,39 @@ class ImageIo : public ::testing::Test {
 std::string readText(const std::string& p) {
   std::ifstream in(p);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// A PNG decoded by PIL: its mode ("L", "RGB", ...), size and raw pixel bytes (row-major, top
+/// row first). Fails the test when python3 or PIL cannot decode the file.
+struct PilImage {
+  std::string mode;
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> pixels;
+};
+
+PilImage decodeWithPil(const std::string& png) {
+  const std::string raw = png + ".pil";
+  const std::string cmd = std::string(WAVOG_PYTHON) +
+                          " -c 'import sys; from PIL import Image; im = Image.open(sys.argv[1]); "
+                          "im.load(); open(sys.argv[2], \"wb\").write(im.tobytes()); "
+                          "print(im.mode, im.size[0], im.size[1])' " +
+                          png + " " + raw;
+  PilImage out;
+  std::FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (pipe == nullptr) {
+    ADD_FAILURE() << "cannot run " << cmd;
+    return out;
+  }
+  char mode[16] = {0};
+  const int fields = std::fscanf(pipe, "%15s %d %d", mode, &out.width, &out.height);
+  const int status = ::pclose(pipe);
+  EXPECT_EQ(fields, 3) << cmd;
+  EXPECT_EQ(status, 0) << cmd;
+  out.mode = mode;
+  const std::string bytes = readText(raw);
+  out.pixels.assign(bytes.begin(), bytes.end());
+  return out;
 }
 
 TEST(GreyFromLogOdds, FreeIsWhiteOccupiedIsBlackLinearInProbability) {
@@ -94,24 +132,54 @@ TEST_F(ImageIo, RenderRgbShowsUnknownInColour) {
   EXPECT_EQ(c.at(0, 0)[0], 127);
 }
 
-TEST_F(ImageIo, PngRoundTripGreyAndRgb) {
-  wavog::Image grey(37, 11, 1);
-  wavog::Image rgb(5, 300, 3);
-  for (std::size_t i = 0; i < grey.pixels.size(); ++i)
-    grey.pixels[i] = static_cast<std::uint8_t>(i * 7);
-  for (std::size_t i = 0; i < rgb.pixels.size(); ++i)
-    rgb.pixels[i] = static_cast<std::uint8_t>(i * 13 + 1);
-  wavog::writePng(path("g.png"), grey);
-  wavog::writePng(path("c.png"), rgb);
-  const wavog::Image g = wavog::readPng(path("g.png"));
-  const wavog::Image c = wavog::readPng(path("c.png"));
-  EXPECT_EQ(g.width, 37);
-  EXPECT_EQ(g.height, 11);
-  EXPECT_EQ(g.channels, 1);
-  EXPECT_EQ(g.pixels, grey.pixels);
-  EXPECT_EQ(c.channels, 3);
-  EXPECT_EQ(c.pixels, rgb.pixels);
-  EXPECT_EQ(readText(path("g.png")).substr(1, 3), "PNG");
+/// A grey and an RGB image whose pixels change from byte to byte (every PNG filter type pays).
+std::vector<wavog::Image> testImages() {
+  std::vector<wavog::Image> images = {wavog::Image(37, 11, 1), wavog::Image(5, 300, 3)};
+  for (std::size_t i = 0; i < images[0].pixels.size(); ++i)
+    images[0].pixels[i] = static_cast<std::uint8_t>(i * 7);
+  for (std::size_t i = 0; i < images[1].pixels.size(); ++i)
+    images[1].pixels[i] = static_cast<std::uint8_t>(i * 13 + 1);
+  return images;
+}
+
+TEST_F(ImageIo, PngWrittenIsDecodedExactlyByAnIndependentDecoderAndReadBack) {
+  for (const wavog::Image& image : testImages()) {
+    wavog::writePng(path("i.png"), image);
+    const PilImage pil = decodeWithPil(path("i.png"));
+    EXPECT_EQ(pil.mode, image.channels == 1 ? "L" : "RGB");
+    EXPECT_EQ(pil.width, image.width);
+    EXPECT_EQ(pil.height, image.height);
+    EXPECT_EQ(pil.pixels, image.pixels);
+    const wavog::Image back = wavog::readPng(path("i.png"));
+    EXPECT_EQ(back.width, image.width);
+    EXPECT_EQ(back.height, image.height);
+    EXPECT_EQ(back.channels, image.channels);
+    EXPECT_EQ(back.pixels, image.pixels);
+  }
+  // A rendered map: the top row is the raster's highest y (see RenderRgbShowsUnknownInColour).
+  const wavog::Image map = wavog::renderRgb(sample());
+  wavog::writePng(path("map.png"), map);
+  EXPECT_EQ(decodeWithPil(path("map.png")).pixels, map.pixels);
+  EXPECT_EQ(readText(path("map.png")).substr(1, 3), "PNG");
+}
+
+TEST_F(ImageIo, PngOfAnIndependentEncoderIsRead) {
+  for (const wavog::Image& image : testImages()) {
+    const std::string raw = path("pil.raw");
+    std::ofstream(raw, std::ios::binary)
+        .write(reinterpret_cast<const char*>(image.pixels.data()),
+               static_cast<std::streamsize>(image.pixels.size()));
+    const std::string cmd = std::string(WAVOG_PYTHON) +
+                            " -c 'import sys; from PIL import Image; "
+                            "Image.frombytes(sys.argv[1], (int(sys.argv[2]), int(sys.argv[3])), "
+                            "open(sys.argv[4], \"rb\").read()).save(sys.argv[5])' " +
+                            (image.channels == 1 ? "L " : "RGB ") + std::to_string(image.width) +
+                            " " + std::to_string(image.height) + " " + raw + " " + path("pil.png");
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    const wavog::Image read = wavog::readPng(path("pil.png"));
+    EXPECT_EQ(read.channels, image.channels);
+    EXPECT_EQ(read.pixels, image.pixels);
+  }
 }
 
 TEST_F(ImageIo, PgmAndMapServerYaml) {
@@ -153,7 +221,9 @@ TEST_F(ImageIo, ErrorsNameTheFile) {
   EXPECT_THROW(wavog::readPgm(path("missing.pgm")), std::runtime_error);
   wavog::writePng(path("ok.png"), img);
   std::string bytes = readText(path("ok.png"));
-  bytes[40] = static_cast<char>(bytes[40] ^ 1);
+  const std::size_t idat = bytes.find("IDAT");  // a damaged byte in the image data
+  ASSERT_NE(idat, std::string::npos);
+  bytes[idat + 6] = static_cast<char>(bytes[idat + 6] ^ 1);
   std::ofstream(path("flip.png"), std::ios::binary) << bytes;
   EXPECT_THROW(wavog::readPng(path("flip.png")), std::runtime_error);
 }

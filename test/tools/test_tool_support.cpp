@@ -1,13 +1,14 @@
 // Tests of the tools' shared pieces: pose algebra, time stamp repair, the CARMEN log plan.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "tool_support.h"
 #include "wavog_mapping/io/carmen_reader.h"
@@ -104,12 +105,15 @@ TEST(CarmenLogPlan, FrontRearAndDuplicateRobotLaser) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(TextHelpers, JsonAndLists) {
-  EXPECT_EQ(wavog_tools::jsonString("a\"b\\c\n"), "\"a\\\"b\\\\c\\n\"");
-  EXPECT_EQ(wavog_tools::jsonNumber(std::nan("")), "null");
+TEST(TextHelpers, Lists) {
   EXPECT_EQ(wavog_tools::splitList(" a, b,,c "), (std::vector<std::string>{"a", "b", "c"}));
   EXPECT_EQ(wavog_tools::stripSlash("/laser"), "laser");
   EXPECT_EQ(wavog_tools::stripSlash("laser"), "laser");
+}
+
+TEST(TextHelpers, WrapText) {
+  EXPECT_EQ(wavog_tools::wrapText("aa bb  cc dddddd e", 5), "aa bb\ncc\ndddddd\ne");
+  EXPECT_EQ(wavog_tools::wrapText("", 5), "");
 }
 
 TEST(TextHelpers, StrictNumbers) {
@@ -130,9 +134,69 @@ TEST(TextHelpers, StrictNumbers) {
       wavog_tools::parseInteger("--scale", bad, 0);
       ADD_FAILURE() << "accepted '" << bad << "'";
     } catch (const std::invalid_argument& e) {
-      EXPECT_EQ(std::string(e.what()), std::string("--scale: not a whole number >= 0: '") + bad + "'");
+      EXPECT_EQ(std::string(e.what()),
+                std::string("--scale: not a whole number >= 0: '") + bad + "'");
     }
   }
+}
+
+TEST(CommandLine, NumbersAreReadWholeAndUsageErrorsGiveStatusTwo) {
+  auto runWith = [](std::vector<std::string> args, double* rate, long* reps, bool* ran) {
+    CLI::App app{"test tool", "wavog_test"};
+    wavog_tools::addNumber(&app, "-r,--rate", rate, "a rate");
+    wavog_tools::addInteger(&app, "--reps", reps, 1, "repetitions");
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    *ran = false;
+    return wavog_tools::runTool(&app, static_cast<int>(argv.size()), argv.data(), [ran] {
+      *ran = true;
+      return 0;
+    });
+  };
+  double rate = 1.0;
+  long reps = 3;
+  bool ran = false;
+  EXPECT_EQ(runWith({"wavog_test", "--rate", "0.25", "--reps", "4"}, &rate, &reps, &ran), 0);
+  EXPECT_TRUE(ran);
+  EXPECT_DOUBLE_EQ(rate, 0.25);
+  EXPECT_EQ(reps, 4);
+  EXPECT_EQ(runWith({"wavog_test", "-r", "-2e1"}, &rate, &reps, &ran), 0);
+  EXPECT_DOUBLE_EQ(rate, -20.0);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(runWith({"wavog_test", "--rate", "0.05x"}, &rate, &reps, &ran), 1);
+  EXPECT_NE(testing::internal::GetCapturedStderr().find(
+                "wavog_test: error: --rate: not a number: '0.05x'"),
+            std::string::npos);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(runWith({"wavog_test", "--reps", "0"}, &rate, &reps, &ran), 1);
+  EXPECT_NE(testing::internal::GetCapturedStderr().find("--reps: not a whole number >= 1: '0'"),
+            std::string::npos);
+  EXPECT_FALSE(ran);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(runWith({"wavog_test", "--no-such-option"}, &rate, &reps, &ran), 2);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("Usage: wavog_test"), std::string::npos) << err;
+  EXPECT_NE(err.find("--rate NUM"), std::string::npos) << err;
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(runWith({"wavog_test", "--help"}, &rate, &reps, &ran), 0);
+  EXPECT_NE(testing::internal::GetCapturedStdout().find("repetitions"), std::string::npos);
+  EXPECT_FALSE(ran);
+}
+
+TEST(Json, WrittenIndentedInKeyOrder) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("wavog_json_" + std::to_string(::getpid())))
+          .string();
+  nlohmann::ordered_json j;
+  j["b"] = 1;
+  j["a"] = std::nan("");
+  j["list"] = {"x\"y"};
+  wavog_tools::writeJson(path, j);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "{\n  \"b\": 1,\n  \"a\": null,\n  \"list\": [\n    \"x\\\"y\"\n  ]\n}\n");
+  std::filesystem::remove(path);
+  EXPECT_THROW(wavog_tools::writeJson("/no/such/dir/x.json", j), std::runtime_error);
 }
 
 }  // namespace

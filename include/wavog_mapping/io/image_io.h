@@ -1,7 +1,7 @@
-// Map pictures: 8-bit grey or RGB images written as PNG (zlib) or PGM, rendering of a
+// Map pictures: 8-bit grey or RGB images written as PNG (libpng) or PGM, rendering of a
 // wavog::Raster (known cells in grey levels from P(occ), unknown in a distinct colour), and the
 // map_server pair (PGM + YAML). Image rows run top to bottom (north up): row 0 holds the raster's
-// highest y. Free functions without state: thread-safe. Lives in wavog_io (std + zlib, no ROS).
+// highest y. Free functions without state: thread-safe. Lives in wavog_io (std, zlib, libpng; no ROS).
 #ifndef WAVOG_MAPPING_IO_IMAGE_IO_H_
 #define WAVOG_MAPPING_IO_IMAGE_IO_H_
 
@@ -65,13 +65,13 @@ Image renderRgb(const Raster& raster, const RenderOptions& options = RenderOptio
 /// Grey picture of a raster: known cells greyFromLogOdds, unknown unknown_grey.
 Image renderGrey(const Raster& raster, const RenderOptions& options = RenderOptions());
 
-/// Writes a PNG (8-bit grey or RGB, zlib-compressed). Throws std::runtime_error naming the file
+/// Writes a PNG (8-bit grey or RGB) with libpng. Throws std::runtime_error naming the file
 /// when it cannot be written or the image is inconsistent (size, channels).
 void writePng(const std::string& path, const Image& image);
 /// Writes a binary PGM (P5, maxval 255) of a grey image. Throws std::runtime_error.
 void writePgm(const std::string& path, const Image& image);
 
-/// Reads an 8-bit grey or RGB non-interlaced PNG (what writePng writes; any filter type).
+/// Reads a PNG with libpng as 8-bit grey (grey files) or RGB (colour files; alpha dropped).
 /// Throws std::runtime_error naming the file for anything else or a damaged file.
 Image readPng(const std::string& path);
 /// Reads a binary PGM (P5, maxval <= 255). Throws std::runtime_error naming the file.

@@ -62,6 +62,10 @@ struct RosParams {
   std::string map_dir;
   /// Relative tolerance of the diagnostics' rate check, in [0, 1).
   double rate_tolerance = 0.5;
+  /// Wall time (s) without any scan or tf after which the input counts as stopped (the end of a
+  /// bag): scans still waiting for tf are integrated with the latest tf and every layer is
+  /// published once more; in [0, 3600], 0: never.
+  double idle_timeout = 2.0;
 };
 
 /// Everything the mapper reads.

@@ -21,7 +21,7 @@ enum class DropReason {
   kEmpty,          ///< no beams
   kSizeMismatch,   ///< ranges size disagrees with angle_min, angle_max, angle_increment
   kBadAngles,      ///< angle_increment zero or non-finite, or non-finite angle limits
-  kBadFrame,       ///< empty frame_id or a leading '/'
+  kBadFrame,       ///< empty frame_id (a leading '/' is stripped first: stripFrameSlash)
   kTfUnavailable,  ///< unknown frame, or tf did not arrive before the queue overflowed
   kTfTooOld,       ///< stamp older than the tf buffer
   kNoValidBeam,    ///< every beam invalid (REP 117): nothing to integrate
@@ -56,6 +56,12 @@ bool checkScanTime(const sensor_msgs::LaserScan& scan, double tolerance, DropRea
 
 /// Short name of a drop reason ("empty", "size_mismatch", ...).
 const char* toString(DropReason reason);
+
+/// tf1-era drivers and bags write frame ids with a leading '/', which tf2 refuses: removes it.
+/// Returns true if it did (the caller warns once per input that it does so).
+bool stripFrameSlash(std::string* frame_id);
+/// The text of that one warning, for the frame as received (e.g. "/laser").
+std::string frameSlashWarning(const std::string& frame_id);
 
 /// Checks what tf cannot: frame id, angles, size against the angles, emptiness. Returns false and
 /// sets *reason when the scan must be dropped. Beam values are not checked (REP 117: the core

@@ -1,0 +1,115 @@
+#!/usr/bin/env python3
+"""Draws wavog_evaluate's figures from the data it writes.
+
+Usage: /usr/bin/python3 scripts/plot_evaluation.py DIR
+
+Reads DIR/figure_data/figures.json, DIR/figure_data/maps/*.png and DIR/figure_data/responses.csv
+(written by wavog_evaluate) and writes, in DIR:
+  policies.png    the final map of every policy side by side (x, y in metres)
+  departure.png   the departed car's mean P(occupied) against time, one line per policy
+  arrival.png     the same for the arrived car (further events: departure_<k>.png, ...)
+Needs matplotlib (Debian: python3-matplotlib); `make demo` runs it.
+"""
+
+import csv
+import json
+import math
+import os
+import sys
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+from figure_common import DPI, run  # noqa: E402; sets matplotlib's display-less backend first
+
+import matplotlib.image as mpimg  # noqa: E402
+import matplotlib.patches as mpatches  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+
+# One colour per policy, told apart on white (Okabe-Ito and darker shades).
+PALETTE = ["#000000", "#e69f00", "#a06e00", "#56b4e9", "#005aa0", "#009e73", "#00643c",
+           "#cc79a7", "#96326e", "#d55e00", "#787878"]
+UNKNOWN = "#aac8eb"  # wavog::RenderOptions::unknown_colour (170, 200, 235)
+COLUMNS = 3
+
+
+def load(data_dir):
+    with open(os.path.join(data_dir, "figures.json")) as f:
+        figures = json.load(f)
+    series = {}
+    with open(os.path.join(data_dir, "responses.csv"), newline="") as f:
+        for row in csv.DictReader(f):
+            key = (int(row["event"]), row["policy"])
+            times, values = series.setdefault(key, ([], []))
+            times.append(float(row["time_s"]))
+            values.append(float(row["mean_p_occ"]))
+    return figures, series
+
+
+def plot_policies(figures, data_dir, out_path):
+    maps = figures["maps"]
+    rows = max(1, math.ceil(len(maps) / COLUMNS))
+    x0, x1, y0, y1 = maps[0]["extent_m"] if maps else (0, 1, 0, 1)
+    panel_w = 5.0
+    panel_h = 0.85 * panel_w * (y1 - y0) / (x1 - x0) + 0.7  # the map, its title, the x label
+    fig = plt.figure(figsize=(panel_w * COLUMNS, panel_h * rows + 1.2), constrained_layout=True)
+    grid = fig.add_gridspec(rows + 1, COLUMNS, height_ratios=[0.5] + [panel_h] * rows)
+    key = fig.add_subplot(grid[0, :])
+    key.axis("off")
+    key.legend(handles=[
+        mpatches.Patch(facecolor="white", edgecolor="0.4", label="free (P(occupied) = 0)"),
+        mpatches.Patch(facecolor="#7f7f7f", label="P = 0.5 (grey linear in P)"),
+        mpatches.Patch(facecolor="black", label="occupied (P = 1)"),
+        mpatches.Patch(facecolor=UNKNOWN, label="never observed")],
+        loc="center", ncol=4, frameon=False, fontsize=11)
+    for i, m in enumerate(maps):
+        ax = fig.add_subplot(grid[1 + i // COLUMNS, i % COLUMNS])
+        ax.imshow(mpimg.imread(os.path.join(data_dir, m["png"])), extent=m["extent_m"],
+                  interpolation="nearest")
+        ax.set_title(m["label"], fontsize=11)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+    fig.suptitle("Final maps at t = %.0f s, %s, one per update policy / initial value"
+                 % (figures["t_end_s"], figures["world"]), fontsize=13)
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
+def plot_event(k, event, figures, series, out_path):
+    departure = event["type"] == "departure"
+    fig, ax = plt.subplots(figsize=(10, 4.6), constrained_layout=True)
+    t0 = max(0.0, event["start_s"] - 2.0)
+    for i, m in enumerate(figures["maps"]):
+        times, values = series.get((k, m["label"]), ([], []))
+        # Runs that differ only in the initial value often coincide: dashed for empty_bound.
+        style = "--" if m["label"].endswith("empty_bound") else "-"
+        ax.plot(times, values, color=PALETTE[i % len(PALETTE)], linestyle=style, linewidth=1.6,
+                label=m["label"])
+    ax.axhline(0.5, color="0.55", linestyle="--", linewidth=1)
+    ax.axvline(event["event_s"], color="0.55", linestyle=":", linewidth=1.2)
+    ax.annotate("stall clear" if departure else "parked", xy=(event["event_s"], 1.0),
+                xytext=(4, -14), textcoords="offset points", color="0.35")
+    ax.set_xlim(t0, figures["t_end_s"])
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("mean P(occupied) of the car's cells")
+    ax.set_title("%s car '%s': mean P(occupied) of its %d cells against time"
+                 % ("Departed" if departure else "Arrived", event["name"], event["cells"]))
+    ax.grid(True, color="0.9")
+    ax.legend(title="policy / initial value", loc="center left", bbox_to_anchor=(1.01, 0.5),
+              frameon=False)
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
+def draw(out_dir):
+    data_dir = os.path.join(out_dir, "figure_data")
+    figures, series = load(data_dir)
+    written = [os.path.join(out_dir, "policies.png")]
+    plot_policies(figures, data_dir, written[0])
+    for k, event in enumerate(figures["events"]):
+        written.append(os.path.join(out_dir, event["figure"]))
+        plot_event(k, event, figures, series, written[-1])
+    return written
+
+
+if __name__ == "__main__":
+    sys.exit(run(sys.argv, __doc__, draw))
