@@ -1,7 +1,8 @@
 # ROS layer targets (issue 3). Neither is part of `make test`.
-#   make tsan         ThreadSanitizer build of the node in $(BUILD_TSAN); runs the integration,
-#                     bad-input, bag-end and reconfigure rostests against it (4 scan inputs, tf,
-#                     timers on 4 threads; the idle flush racing the tf filters; live reconfigure).
+#   make tsan         ThreadSanitizer build in $(BUILD_TSAN); runs the core's parallel integration
+#                     test (1, 2, 4 threads), then the integration, bad-input, bag-end and
+#                     reconfigure rostests against the node (4 scan inputs, tf, timers on 4
+#                     threads; the idle flush racing the tf filters; live reconfigure).
 #                     roscpp-internal reports are suppressed (test/ros/tsan.supp). ~4 min on 2 cores.
 #   make rviz-check   installs rviz + Xvfb (separate from `make deps`), plays 40 s of the simulated
 #                     car park through launch/playback.launch (config/lms291_x4.yaml) with
@@ -18,8 +19,13 @@ tsan: deps
 	  -DWAVOG_SANITIZE=thread -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  >$(BUILD_TSAN)/configure.log || { cat $(BUILD_TSAN)/configure.log; exit 1; }
 	@bash $(ROOT)/scripts/build.sh $(BUILD_TSAN) $(JOBS) wavog_mapping_node test_mapping_system \
-	  test_bad_input test_bag_end test_reconfigure_policy
+	  test_bad_input test_bag_end test_reconfigure_policy test_parallel_integration
 	@rm -f $(BUILD_TSAN)/tsan/report.*
+	@# The core's parallel integration (worker threads, node pool) with 1, 2 and 4 threads.
+	@TSAN_OPTIONS="log_path=$(BUILD_TSAN)/tsan/report second_deadlock_stack=1" \
+	  $(BUILD_TSAN)/tests/test_parallel_integration >$(BUILD_TSAN)/tsan/core.log 2>&1 || \
+	  { tail -20 $(BUILD_TSAN)/tsan/core.log; cat $(BUILD_TSAN)/tsan/report.* 2>/dev/null; \
+	    echo "tsan: the core's parallel integration test failed"; exit 1; }
 	@$(ROS_ENV); source $(BUILD_TSAN)/devel/setup.bash; \
 	  export ROS_HOME=$(BUILD_TSAN)/ros_home; \
 	  export TSAN_OPTIONS="log_path=$(BUILD_TSAN)/tsan/report second_deadlock_stack=1 history_size=4 suppressions=$(ROOT)/test/ros/tsan.supp"; \

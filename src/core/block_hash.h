@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <unordered_map>
+#include <vector>
 
 #include "node_pool.h"
 
@@ -20,6 +21,8 @@ struct Block {
   bool has_root = false;   ///< false: the block is uniform at s
   bool known_all = false;  ///< every cell observed
   bool known_any = false;  ///< some cell observed
+  /// Node groups this block freed during integrations, reused by its next ones (NodeStore).
+  std::vector<std::uint32_t> spare;
 };
 
 inline std::uint64_t blockKey(std::int64_t bx, std::int64_t by) {

@@ -21,8 +21,8 @@ struct ClearBox {
 
 // Sets every finest cell of the box inside node `n` (level l, origin ix0/iy0, average s) back to
 // the prior and unobserved. Returns the change of n's average.
-double clearNode(WaveletMap::Impl& impl, Node& n, int l, std::int64_t ix0, std::int64_t iy0,
-                 double s, const ClearBox& box) {
+double clearNode(WaveletMap::Impl& impl, detail::NodeStore& store, Node& n, int l, std::int64_t ix0,
+                 std::int64_t iy0, double s, const ClearBox& box) {
   impl.flush(n);
   const auto c = haar::backward(s, n.d);
   std::array<double, 4> delta{};
@@ -32,7 +32,7 @@ double clearNode(WaveletMap::Impl& impl, Node& n, int l, std::int64_t ix0, std::
     const std::int64_t cy = iy0 + ((q & 2) ? half : 0);
     const std::int64_t ex = cx + half - 1, ey = cy + half - 1;
     if (ex < box.x0 || cx > box.x1 || ey < box.y0 || cy > box.y1) continue;
-    detail::ChildSlot slot(impl, n, q);
+    detail::ChildSlot slot(impl, store, n, q);
     const double cq = c[static_cast<std::size_t>(q)];
     const bool inside = cx >= box.x0 && ex <= box.x1 && cy >= box.y0 && ey <= box.y1;
     if (inside || l == 1) {
@@ -41,8 +41,9 @@ double clearNode(WaveletMap::Impl& impl, Node& n, int l, std::int64_t ix0, std::
       slot.setKnown(false, false);
       continue;
     }
-    delta[static_cast<std::size_t>(q)] = detail::refineSlot(
-        slot, slot.node(), [&](Node& m) { return clearNode(impl, m, l - 1, cx, cy, cq, box); });
+    delta[static_cast<std::size_t>(q)] = detail::refineSlot(slot, slot.node(), [&](Node& m) {
+      return clearNode(impl, store, m, l - 1, cx, cy, cq, box);
+    });
   }
   return detail::foldChanges(n, delta);
 }
@@ -76,13 +77,15 @@ void WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y
         x0 >= box.x0 && x0 + size - 1 <= box.x1 && y0 >= box.y0 && y0 + size - 1 <= box.y1;
     if (inside) {
       if (b.has_root) impl.removeRoot(&b);
-      impl.blocks.erase(key);
+      impl.eraseBlock(key);
       continue;
     }
-    detail::RootSlot slot(impl, b);
+    // The block's groups stay with it (as in an integration, see NodeStore).
+    detail::NodeStore store(impl.pool, &b.spare, &impl.nodes, impl.pool.liveCounter());
+    detail::RootSlot slot(impl, store, b);
     const double s = b.s;
-    b.s += detail::refineSlot(slot, slot.node(),
-                              [&](Node& m) { return clearNode(impl, m, L, x0, y0, s, box); });
+    b.s += detail::refineSlot(
+        slot, slot.node(), [&](Node& m) { return clearNode(impl, store, m, L, x0, y0, s, box); });
     impl.dropIfEmpty(bx, by);
   }
 }

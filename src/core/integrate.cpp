@@ -1,9 +1,14 @@
 // WaveletMap::integrate: one scan into the map (ALGORITHM.md sections 3 and 6). The scan is
 // prepared and classified by the ScanClassifier (scan_classifier.h); every block within its
 // reach that is not U goes through the quadtree update Integrator<P> (quadtree_update.h), one
-// instantiation per update policy.
+// instantiation per update policy. The touched blocks are found and created first, on the calling
+// thread; with num_threads != 1 they are then updated on the map's worker threads.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <memory>
+#include <thread>
+#include <vector>
 
 #include "map_impl.h"
 #include "quadtree_update.h"
@@ -28,6 +33,45 @@ CellBox reachBox(double px, double py, double reach, double res) {
   return box;
 }
 
+// One block of the scan: its storage, origin cell and class.
+struct BlockJob {
+  detail::Block* block;
+  std::int64_t ix0, iy0;
+  detail::SquareInfo box;
+};
+
+// Node groups one block can take in one scan at most: a group per node of levels 2..L (a
+// block's live and spare groups never exceed that, and fresh ones are taken only when its
+// spares are used up).
+std::size_t maxGroupsPerBlock(int levels) {
+  return ((std::size_t{1} << (2 * (levels - 1))) - 1) / 3;
+}
+
+// Participants of parallel integrations: num_threads, 0 meaning every core.
+int threadsFor(const MapParams& p) {
+  if (p.num_threads != 0) return p.num_threads;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+// Updates the blocks jobs[i] for the indices i taken from `next` (shared by the threads of one
+// scan); node groups from `store`. Returns the nodes visited. The one place Integrator<P> is
+// made, so the hot code is compiled once per policy.
+template <PolicyType P>
+[[gnu::noinline]] std::uint64_t updateBlocks(WaveletMap::Impl& impl, detail::NodeStore& store,
+                                             const ScanClassifier& cls,
+                                             const detail::PolicyConsts& pc,
+                                             const std::vector<BlockJob>& jobs,
+                                             std::atomic<std::size_t>* next) {
+  detail::Integrator<P> integrator(impl, store, cls, pc);
+  for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < jobs.size();
+       i = next->fetch_add(1, std::memory_order_relaxed)) {
+    const BlockJob& j = jobs[i];
+    store.useSpare(&j.block->spare);
+    integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
+  }
+  return integrator.visited();
+}
+
 template <PolicyType P>
 std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, IntegrateStats* st) {
   const MapParams& p = impl.params;
@@ -38,11 +82,15 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, In
                                 p.policy.clamp_min,
                                 p.policy.clamp_max,
                                 std::max(p.skip_tolerance, kUnchangedFloor)};
-  detail::Integrator<P> integrator(impl, cls, pc);
   const detail::PreparedScan& ps = cls.scan();
   const int L = impl.levels;
   const double block_size = static_cast<double>(std::int64_t{1} << L) * ps.res;
   const CellBox blocks = reachBox(ps.px, ps.py, ps.reach, block_size);
+  // Serial: classify the blocks and create the touched ones (the hash changes only here, in the
+  // same order whatever the thread count, so its iteration order, and the saved file, are too).
+  thread_local std::vector<BlockJob> job_buffer;  // reused from scan to scan
+  std::vector<BlockJob>& jobs = job_buffer;       // the workers read this thread's copy
+  jobs.clear();
   std::uint64_t visited = 0;
   for (std::int64_t by = blocks.min_y; by < blocks.max_y; ++by) {
     for (std::int64_t bx = blocks.min_x; bx < blocks.max_x; ++bx) {
@@ -50,11 +98,45 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, In
       const detail::SquareInfo box = cls.classifySquare(L, ix0, iy0);
       ++visited;
       if (box.cls == CellClass::kUnknown) continue;
-      ++st->blocks_touched;
-      integrator.integrateBlock(impl.getOrCreateBlock(bx, by), ix0, iy0, box);
+      jobs.push_back({&impl.getOrCreateBlock(bx, by), ix0, iy0, box});
     }
   }
-  return visited + integrator.visited();
+  st->blocks_touched = static_cast<std::uint32_t>(jobs.size());
+  // The blocks are independent: each one's update reads only the scan and the parameters and
+  // changes only its own nodes, taking node groups from its own spares (NodeStore), so the result
+  // does not depend on which thread updates which block, nor in which order.
+  // The chunk table grows here, whatever the thread count, so that its size does not depend on it.
+  impl.pool.reserveFresh(jobs.size() * maxGroupsPerBlock(L));
+  const int threads = std::min(threadsFor(p), static_cast<int>(jobs.size()));
+  std::atomic<std::size_t> next{0};
+  if (threads <= 1) {
+    detail::NodeStore store(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
+    return visited + updateBlocks<P>(impl, store, cls, pc, jobs, &next);
+  }
+  if (!impl.workers || impl.workers->threads() != threadsFor(p)) {
+    impl.workers = std::make_unique<detail::WorkerPool>(threadsFor(p));
+  }
+  // Per participant: visits and node / group count changes (modulo 2^64), on their own cache
+  // lines.
+  struct alignas(64) Tally {
+    std::uint64_t visited = 0;
+    std::size_t nodes = 0, groups = 0;
+  };
+  std::vector<Tally> tallies(static_cast<std::size_t>(impl.workers->threads()));
+  const auto active = static_cast<std::size_t>(threads);
+  impl.workers->run([&](int t) {
+    const auto tu = static_cast<std::size_t>(t);
+    if (tu >= active) return;
+    Tally& tally = tallies[tu];
+    detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
+    tally.visited = updateBlocks<P>(impl, store, cls, pc, jobs, &next);
+  });
+  for (const Tally& tally : tallies) {
+    visited += tally.visited;
+    impl.nodes += tally.nodes;
+    impl.pool.addLive(tally.groups);
+  }
+  return visited;
 }
 
 // One instantiation per policy, in the order of PolicyType's enumerators.

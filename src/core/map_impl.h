@@ -7,11 +7,13 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 
 #include "block_hash.h"
 #include "node_pool.h"
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/wavelet_map.h"
+#include "worker_pool.h"
 
 namespace wavog {
 namespace detail {
@@ -37,6 +39,8 @@ struct WaveletMap::Impl {
 
   detail::NodePool pool;
   detail::BlockMap blocks;
+  /// Worker threads of parallel integrations (num_threads != 1), made on the first one.
+  std::unique_ptr<detail::WorkerPool> workers;
   std::size_t nodes = 0;  ///< live nodes (roots included)
   std::uint64_t nodes_visited_last = 0;
 
@@ -49,24 +53,40 @@ struct WaveletMap::Impl {
   }
   bool hasChild(const detail::Node& n, int q) const { return (n.child_mask >> q) & 1u; }
 
+  /// Node groups and counts for one thread at a time: the pool's own free list, the map's counts.
+  detail::NodeStore serialStore() { return {pool, nullptr, &nodes, pool.liveCounter()}; }
+
   /// Installs `m` as child q of `n` (allocating the group if needed); returns the stored node.
-  detail::Node& installChild(detail::Node& n, int q, const detail::Node& m);
+  detail::Node& installChild(detail::NodeStore& store, detail::Node& n, int q,
+                             const detail::Node& m);
+  detail::Node& installChild(detail::Node& n, int q, const detail::Node& m) {
+    detail::NodeStore store = serialStore();
+    return installChild(store, n, q, m);
+  }
   /// Removes child q of `n` and its whole subtree.
-  void removeChild(detail::Node& n, int q);
+  void removeChild(detail::NodeStore& store, detail::Node& n, int q);
+  void removeChild(detail::Node& n, int q) {
+    detail::NodeStore store = serialStore();
+    removeChild(store, n, q);
+  }
   /// Stores `m` as the root node of block `b`.
-  void installRoot(detail::Block* b, const detail::Node& m) {
+  static void installRoot(detail::NodeStore& store, detail::Block* b, const detail::Node& m) {
     b->root = m;
     b->has_root = true;
-    ++nodes;
+    store.nodeAdded();
   }
   /// Deletes the root node of block `b` and its subtree (the block becomes uniform).
-  void removeRoot(detail::Block* b) {
-    freeSubtree(b->root);
+  void removeRoot(detail::NodeStore& store, detail::Block* b) {
+    freeSubtree(store, b->root);
     b->has_root = false;
-    --nodes;
+    store.nodeRemoved();
+  }
+  void removeRoot(detail::Block* b) {
+    detail::NodeStore store = serialStore();
+    removeRoot(store, b);
   }
   /// Frees every node below `n` (not n itself).
-  void freeSubtree(detail::Node& n);
+  void freeSubtree(detail::NodeStore& store, detail::Node& n);
 
   /// Applies n's pending count to its details and hands it to its children (ALGORITHM.md F1).
   void flush(detail::Node& n);
@@ -88,16 +108,19 @@ struct WaveletMap::Impl {
   detail::Block& getOrCreateBlock(std::int64_t bx, std::int64_t by);
   /// Drops a block that holds nothing (uniform, unobserved, at the prior).
   void dropIfEmpty(std::int64_t bx, std::int64_t by);
+  /// Erases block `key` (its nodes must be freed already); its spare groups go to the pool.
+  void eraseBlock(std::uint64_t key);
 };
 
 // Hot helpers of the integration, inline so the shared library calls them without a PLT hop.
 
-inline detail::Node& WaveletMap::Impl::installChild(detail::Node& n, int q, const detail::Node& m) {
-  if (n.children == 0) n.children = pool.allocate();
+inline detail::Node& WaveletMap::Impl::installChild(detail::NodeStore& store, detail::Node& n,
+                                                    int q, const detail::Node& m) {
+  if (n.children == 0) n.children = store.allocate();
   n.child_mask = static_cast<std::uint8_t>(n.child_mask | (1u << q));
   detail::Node& c = child(n, q);
   c = m;
-  ++nodes;
+  store.nodeAdded();
   return c;
 }
 

@@ -247,6 +247,7 @@ void WaveletMap::load(const std::string& path) {
   } catch (const std::exception& e) {
     throw fail(std::string("malformed content: ") + e.what());
   }
+  fresh.workers = std::move(impl_->workers);  // the threads live as long as the map
   *impl_ = std::move(fresh);
 }
 

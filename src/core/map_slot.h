@@ -2,7 +2,8 @@
 // node (ChildSlot), each with the knowledge bits of its cells. An update reads a slot's node (or a
 // temporary uniform one when it has none), changes it, and settles the slot: a stored node that
 // became trivial is deleted, a temporary that did not is stored. Used by the integration and by
-// region clearing. Not installed; included only by src/core/*.
+// region clearing; node groups come from and go to the slot's NodeStore. Not installed; included
+// only by src/core/*.
 #ifndef WAVOG_MAPPING_SRC_CORE_MAP_SLOT_H_
 #define WAVOG_MAPPING_SRC_CORE_MAP_SLOT_H_
 
@@ -18,7 +19,8 @@ namespace detail {
 /// The root slot of block `b`.
 class RootSlot {
  public:
-  RootSlot(WaveletMap::Impl& impl, Block& b) : impl_(impl), b_(b) {}
+  RootSlot(WaveletMap::Impl& impl, NodeStore& store, Block& b)
+      : impl_(impl), store_(store), b_(b) {}
   WaveletMap::Impl& impl() const { return impl_; }
   /// The stored node, or nullptr when the block is uniform.
   Node* node() const { return b_.has_root ? &b_.root : nullptr; }
@@ -28,19 +30,24 @@ class RootSlot {
     b_.known_all = all;
     b_.known_any = any;
   }
-  void install(const Node& m) { impl_.installRoot(&b_, m); }
-  void remove() { impl_.removeRoot(&b_); }
+  void install(const Node& m) { WaveletMap::Impl::installRoot(store_, &b_, m); }
+  void remove() { impl_.removeRoot(store_, &b_); }
 
  private:
   WaveletMap::Impl& impl_;
+  NodeStore& store_;
   Block& b_;
 };
 
 /// The slot of child q of node `parent`.
 class ChildSlot {
  public:
-  ChildSlot(WaveletMap::Impl& impl, Node& parent, int q)
-      : impl_(impl), parent_(parent), q_(q), bit_(static_cast<std::uint8_t>(1u << q)) {}
+  ChildSlot(WaveletMap::Impl& impl, NodeStore& store, Node& parent, int q)
+      : impl_(impl),
+        store_(store),
+        parent_(parent),
+        q_(q),
+        bit_(static_cast<std::uint8_t>(1u << q)) {}
   WaveletMap::Impl& impl() const { return impl_; }
   /// The stored child node, or nullptr when the child is uniform.
   Node* node() const { return impl_.hasChild(parent_, q_) ? &impl_.child(parent_, q_) : nullptr; }
@@ -50,11 +57,12 @@ class ChildSlot {
     setBit(&parent_.known_all, bit_, all);
     setBit(&parent_.known_any, bit_, any);
   }
-  void install(const Node& m) { impl_.installChild(parent_, q_, m); }
-  void remove() { impl_.removeChild(parent_, q_); }
+  void install(const Node& m) { impl_.installChild(store_, parent_, q_, m); }
+  void remove() { impl_.removeChild(store_, parent_, q_); }
 
  private:
   WaveletMap::Impl& impl_;
+  NodeStore& store_;
   Node& parent_;
   int q_;
   std::uint8_t bit_;

@@ -29,8 +29,10 @@ MapStats WaveletMap::stats(bool count_observed) const {
   st.nodes = impl.nodes;
   // Hash: one heap node per block (key, Block, next pointer, cached hash) plus the bucket array.
   const std::size_t per_block = sizeof(std::uint64_t) + sizeof(Block) + 2 * sizeof(void*);
-  const std::size_t rest =
-      impl.blocks.size() * per_block + impl.blocks.bucket_count() * sizeof(void*) + sizeof(Impl);
+  std::size_t spare = 0;  // the blocks' lists of spare node groups
+  for (const auto& kv : impl.blocks) spare += kv.second.spare.capacity() * sizeof(std::uint32_t);
+  const std::size_t rest = impl.blocks.size() * per_block +
+                           impl.blocks.bucket_count() * sizeof(void*) + sizeof(Impl) + spare;
   st.bytes = impl.pool.bytes() + rest;
   st.bytes_reserved = impl.pool.bytesReserved() + rest;
   st.nodes_visited_last = impl.nodes_visited_last;

@@ -10,6 +10,11 @@ namespace wavog {
 using detail::Block;
 using detail::Node;
 
+namespace {
+// Spare groups a new block takes from the pool's own free list.
+constexpr std::size_t kLentGroups = 64;
+}  // namespace
+
 WaveletMap::Impl::Impl(const MapParams& p) : params(p) {
   throwIfInvalid(p);
   levels = p.grid.block_levels;
@@ -38,25 +43,25 @@ void WaveletMap::Impl::configure() {
   }
 }
 
-void WaveletMap::Impl::freeSubtree(Node& n) {
+void WaveletMap::Impl::freeSubtree(detail::NodeStore& store, Node& n) {
   if (n.children == 0) return;
   for (int q = 0; q < 4; ++q) {
     if (hasChild(n, q)) {
-      freeSubtree(child(n, q));
-      --nodes;
+      freeSubtree(store, child(n, q));
+      store.nodeRemoved();
     }
   }
-  pool.release(n.children);
+  store.release(n.children);
   n.children = 0;
   n.child_mask = 0;
 }
 
-void WaveletMap::Impl::removeChild(Node& n, int q) {
-  freeSubtree(child(n, q));
-  --nodes;
+void WaveletMap::Impl::removeChild(detail::NodeStore& store, Node& n, int q) {
+  freeSubtree(store, child(n, q));
+  store.nodeRemoved();
   n.child_mask = static_cast<std::uint8_t>(n.child_mask & ~(1u << q));
   if (n.child_mask == 0) {
-    pool.release(n.children);
+    store.release(n.children);
     n.children = 0;
   }
 }
@@ -89,7 +94,11 @@ const Block* WaveletMap::Impl::findBlock(std::int64_t bx, std::int64_t by) const
 
 Block& WaveletMap::Impl::getOrCreateBlock(std::int64_t bx, std::int64_t by) {
   auto res = blocks.try_emplace(detail::blockKey(bx, by));
-  if (res.second) res.first->second.s = init;
+  if (res.second) {
+    res.first->second.s = init;
+    // Groups of erased blocks go to new ones (integrations take only their block's spares).
+    pool.lend(kLentGroups, &res.first->second.spare);
+  }
   return res.first->second;
 }
 
@@ -97,7 +106,14 @@ void WaveletMap::Impl::dropIfEmpty(std::int64_t bx, std::int64_t by) {
   auto it = blocks.find(detail::blockKey(bx, by));
   if (it == blocks.end()) return;
   const Block& b = it->second;
-  if (!b.has_root && !b.known_any && b.s == init) blocks.erase(it);
+  if (!b.has_root && !b.known_any && b.s == init) eraseBlock(it->first);
+}
+
+void WaveletMap::Impl::eraseBlock(std::uint64_t key) {
+  auto it = blocks.find(key);
+  if (it == blocks.end()) return;
+  for (std::uint32_t g : it->second.spare) pool.recycle(g);
+  blocks.erase(it);
 }
 
 }  // namespace wavog

@@ -31,6 +31,8 @@ void check(bool ok, const char* name, double value, const char* rule,
   out->push_back(s.str());
 }
 
+constexpr int kMaxThreads = 256;
+
 bool usesLowerClamp(PolicyType t) {
   return t == PolicyType::kClamp || t == PolicyType::kClampLower;
 }
@@ -97,6 +99,8 @@ std::vector<std::string> MapParams::validate() const {
         "prune_threshold", prune_threshold, "in [0, 1] log-odds", &v);
   check(finite(skip_tolerance) && skip_tolerance >= 0.0 && skip_tolerance <= 1.0, "skip_tolerance",
         skip_tolerance, "in [0, 1] log-odds", &v);
+  check(num_threads >= 0 && num_threads <= kMaxThreads, "num_threads", num_threads,
+        "an integer in [0, 256] (0: one per core)", &v);
   // clamp_min < clamp_max needs no rule of its own: the two rules above force their signs.
   return v;
 }

@@ -21,15 +21,17 @@ namespace detail {
 template <PolicyType P>
 class Integrator {
  public:
-  Integrator(WaveletMap::Impl& impl, const ScanClassifier& classifier, const PolicyConsts& pc)
-      : impl_(impl), cls_(classifier), pc_(pc), lazy_(impl.params.lazy_forgetting) {}
+  /// Node groups come from and go to `store` (one Integrator per thread).
+  Integrator(WaveletMap::Impl& impl, NodeStore& store, const ScanClassifier& classifier,
+             const PolicyConsts& pc)
+      : impl_(impl), store_(store), cls_(classifier), pc_(pc), lazy_(impl.params.lazy_forgetting) {}
 
   /// Tree nodes and finest cells visited so far.
   std::uint64_t visited() const { return visited_; }
 
   /// Updates block `b` (origin cell ix0, iy0) classified as `box`.
   void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) {
-    RootSlot slot(impl_, b);
+    RootSlot slot(impl_, store_, b);
     const double s = b.s;
     b.s += updateSlot(slot, box.cls, s,
                       [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
@@ -101,7 +103,7 @@ class Integrator {
       const SquareInfo child_box = cls_.classifySquare(l - 1, cx, cy, box);
       ++visited_;
       if (child_box.cls == CellClass::kUnknown) continue;
-      ChildSlot slot(impl_, n, q);
+      ChildSlot slot(impl_, store_, n, q);
       delta[qu] = updateSlot(slot, child_box.cls, c[qu], [&](Node& m) {
         return visitNode(m, child_box, l - 1, cx, cy, c[qu]);
       });
@@ -156,7 +158,7 @@ class Integrator {
       const CellMasks cc{quad(cells.e >> shift), quad(cells.o >> shift)};
       const CellClass cls = slotClass(cc);
       if (cls == CellClass::kUnknown) continue;
-      ChildSlot slot(impl_, n, q);
+      ChildSlot slot(impl_, store_, n, q);
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
@@ -188,6 +190,7 @@ class Integrator {
   }
 
   WaveletMap::Impl& impl_;
+  NodeStore& store_;
   const ScanClassifier& cls_;
   const PolicyConsts pc_;
   const bool lazy_;

@@ -136,6 +136,7 @@ const std::vector<KeyReader>& readers() {
        [](auto& k, auto& v, Config* c) { c->map.skip_tolerance = asDouble(k, v); }},
       {"lazy_forgetting",
        [](auto& k, auto& v, Config* c) { c->map.lazy_forgetting = asBool(k, v); }},
+      {"num_threads", [](auto& k, auto& v, Config* c) { c->map.num_threads = asInt(k, v); }},
       // ---- ROS
       {"map_frame", [](auto& k, auto& v, Config* c) { c->ros.map_frame = asString(k, v); }},
       {"base_frame", [](auto& k, auto& v, Config* c) { c->ros.base_frame = asString(k, v); }},

@@ -63,6 +63,7 @@ struct Options {
   double snapshot_every = 0.0;
   bool progress = true;
   bool quiet = false;
+  int threads = -1;  // -1: the YAML's num_threads
 };
 
 std::vector<int> parseScales(const std::string& text) {
@@ -108,6 +109,10 @@ void addOptions(CLI::App* app, Options* o) {
   wavog_tools::addNumber(app, "--snapshot-every", &o->snapshot_every,
                          "also write snapshots/t<seconds>_s<scale>.png every S s of log time "
                          "(0: none)");
+  wavog_tools::addInteger(app, "--threads", &o->threads, 0,
+                          "threads updating one scan's blocks (num_threads; 0: one per core; the "
+                          "map is the same for every N)")
+      ->default_str("the YAML's");
   app->add_flag_callback(
       "--no-progress", [o] { o->progress = false; }, "no progress bar");
   app->add_flag_callback(
@@ -143,6 +148,7 @@ wavog_ros::Config loadConfig(const Options& o, std::vector<std::string>* unknown
   }
   if (!o.policy.empty()) root["policy"] = o.policy;
   if (o.resolution > 0.0) root["resolution"] = o.resolution;
+  if (o.threads >= 0) root["num_threads"] = o.threads;
   if (!o.aggregation.empty()) root["scale_aggregation"] = o.aggregation;
   try {
     return wavog_ros::configFromXmlRpc(root, unknown);

@@ -1,6 +1,7 @@
 // Core benchmarks (make bench): scans/s, nodes visited per scan and bytes per observed cell for
 // clamping, lazy forgetting and eager forgetting on fr079 and on synthetic 80 m LMS-291 scans,
-// then the ratios of the targets, computed from medians measured in this same run.
+// then the ratios of the targets, computed from medians measured in this same run; and
+// the speed-up of 2 threads over 1 (num_threads) at two block sizes (blocks per scan).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -131,6 +132,66 @@ void BM_Integrate(benchmark::State& state, std::string wl, double res, Variant v
   state.counters["bytes_per_cell"] = f.bytes_per_cell;
 }
 
+// Parallel integration (num_threads): wall-clock time, since the work is on several threads.
+// `levels`: block_levels, which sets the blocks per scan (the unit of work shared out).
+std::map<std::string, std::vector<double>> g_wall;  // key -> scans/s per repetition
+std::map<std::string, double> g_blocks_per_scan;
+
+double clockSeconds(clockid_t clock) {
+  timespec ts{};
+  clock_gettime(clock, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+double wallSeconds() { return clockSeconds(CLOCK_MONOTONIC); }
+
+std::string parallelKey(const std::string& wl, Variant v, int levels, int threads) {
+  return wl + "@5cm/" + kVariantNames[v] + "/L" + std::to_string(levels) + "/threads:" +
+         std::to_string(threads);
+}
+
+void BM_Parallel(benchmark::State& state, std::string wl, Variant v, int levels, int threads) {
+  const auto& scans = workload(wl);
+  if (scans.empty()) {
+    state.SkipWithError("data set not found (../shared/data or WAVOG_DATA_DIR)");
+    return;
+  }
+  const std::string key = parallelKey(wl, v, levels, threads);
+  MapParams p = paramsFor(v, 0.05, 0.0);
+  p.grid.block_levels = levels;
+  p.num_threads = threads;
+  double rate = 0, blocks = 0, cpu_us = 0;
+  for (auto _ : state) {
+    wavog::WaveletMap map(p);
+    std::uint64_t touched = 0;
+    map.integrate(scans[0].pose, scans[0].view());  // starts the workers outside the timing
+    map.reset();
+    const double t0 = wallSeconds(), c0 = clockSeconds(CLOCK_PROCESS_CPUTIME_ID);
+    for (const auto& s : scans) touched += map.integrate(s.pose, s.view()).blocks_touched;
+    const double secs = wallSeconds() - t0;
+    // CPU time of every thread: the work, whatever the load (its growth is the cost of sharing).
+    cpu_us = 1e6 * (clockSeconds(CLOCK_PROCESS_CPUTIME_ID) - c0) / static_cast<double>(scans.size());
+    state.SetIterationTime(secs);
+    rate = static_cast<double>(scans.size()) / secs;
+    blocks = static_cast<double>(touched) / static_cast<double>(scans.size());
+    g_wall[key].push_back(rate);
+  }
+  g_blocks_per_scan[key] = blocks;
+  state.counters["scans_per_s"] = rate;
+  state.counters["blocks_per_scan"] = blocks;
+  state.counters["cpu_us_per_scan"] = cpu_us;
+}
+
+// The parallel cases: (workload, variant, block_levels).
+struct ParallelCase {
+  const char* wl;
+  Variant v;
+  int levels;
+};
+constexpr ParallelCase kParallelCases[] = {{"synthetic80m", kForgetLazy, 9},
+                                           {"synthetic80m", kForgetLazy, 7},
+                                           {"fr079", kClamp, 9},
+                                           {"fr079", kClamp, 7}};
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -158,6 +219,20 @@ void printSummary() {
   }
   if (g_rates.count("synthetic80m@5cm/forget_lazy")) {
     std::printf("synthetic80m@5cm forget_lazy: %.0f scans/s (target >= 1000)\n", m("synthetic80m@5cm/forget_lazy"));
+  }
+  bool any_parallel = false;
+  for (const auto& c : kParallelCases) {
+    const std::string one = parallelKey(c.wl, c.v, c.levels, 1), two = parallelKey(c.wl, c.v, c.levels, 2);
+    if (!g_wall.count(one) || !g_wall.count(two)) continue;
+    if (!any_parallel) {
+      std::printf("\n== Parallel integration: 2 threads over 1 (wall-clock medians, this run) ==\n");
+      any_parallel = true;
+    }
+    std::printf("%-36s %8.0f -> %8.0f scans/s, speed-up %.2f (%.1f blocks/scan; target >= 1.7 on "
+                "synthetic80m L9)\n",
+                (std::string(c.wl) + "@5cm/" + kVariantNames[c.v] + "/L" + std::to_string(c.levels)).c_str(),
+                median(g_wall[one]), median(g_wall[two]), median(g_wall[two]) / median(g_wall[one]),
+                g_blocks_per_scan[one]);
   }
   // Memory and pruning error on fr079 at 5 cm with forgetting, tau = 0, 0.01, 0.05.
   if (!g_rates.count("fr079@5cm/forget_lazy")) return;  // only with the fr079 5 cm runs
@@ -203,6 +278,19 @@ int main(int argc, char** argv) {
             ->Repetitions(5)
             ->ReportAggregatesOnly(true);
       }
+    }
+  }
+  // Interleaved with the others by --benchmark_enable_random_interleaving (make bench), so the
+  // 1- and 2-thread figures of one case see the same load.
+  for (const auto& c : kParallelCases) {
+    for (int threads : {1, 2}) {
+      const std::string name = std::string("parallel/") + parallelKey(c.wl, c.v, c.levels, threads);
+      benchmark::RegisterBenchmark(name.c_str(), BM_Parallel, std::string(c.wl), c.v, c.levels, threads)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond)
+          ->Iterations(1)
+          ->Repetitions(5)
+          ->ReportAggregatesOnly(true);
     }
   }
   benchmark::Initialize(&argc, argv);

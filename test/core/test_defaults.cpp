@@ -45,7 +45,8 @@ std::map<std::string, std::string> coreDefaults() {
           {"no_return_clear", num(d.sensor.no_return_clear)},
           {"prune_threshold", num(d.prune_threshold)},
           {"skip_tolerance", num(d.skip_tolerance)},
-          {"lazy_forgetting", d.lazy_forgetting ? "true" : "false"}};
+          {"lazy_forgetting", d.lazy_forgetting ? "true" : "false"},
+          {"num_threads", num(d.num_threads)}};
 }
 
 // A number as written in a file, normalised like num() above ("0.0" -> "0", "-2.0" -> "-2").

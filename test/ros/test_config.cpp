@@ -47,6 +47,7 @@ void expectSame(const Config& a, const Config& b) {
   EXPECT_EQ(a.map.prune_threshold, b.map.prune_threshold);
   EXPECT_EQ(a.map.skip_tolerance, b.map.skip_tolerance);
   EXPECT_EQ(a.map.lazy_forgetting, b.map.lazy_forgetting);
+  EXPECT_EQ(a.map.num_threads, b.map.num_threads);
   EXPECT_EQ(a.ros.map_frame, b.ros.map_frame);
   EXPECT_EQ(a.ros.base_frame, b.ros.base_frame);
   ASSERT_EQ(a.ros.inputs.size(), b.ros.inputs.size());
@@ -158,6 +159,8 @@ TEST(Config, BadValuesNameTheParameterAndItsRange) {
   EXPECT_NE(errorOf("queue_size: 2.5").find("integer"), std::string::npos);
   EXPECT_NE(errorOf("motion_compensation: 1").find("true or false"), std::string::npos);
   EXPECT_NE(errorOf("gamma: 0").find("gamma"), std::string::npos);
+  EXPECT_NE(errorOf("num_threads: -1").find("num_threads (-1) must be an integer in [0, 256]"),
+            std::string::npos);
   EXPECT_NE(errorOf("inputs: [{topic: a, rate: 3}]").find("unknown key 'rate'"), std::string::npos);
 }
 

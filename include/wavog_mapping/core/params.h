@@ -91,6 +91,10 @@ struct MapParams {
   /// Forgetting only: use lazy tags on fully-empty nodes (ALGORITHM.md section 6). false applies
   /// the forgetting eagerly to every stored detail (slow; for benchmarks and tests).
   bool lazy_forgetting = true;
+  /// Threads that update one scan's blocks: the calling thread and num_threads - 1 workers that
+  /// live as long as the map; 0: one per core. In [0, 256]. The map is bit-identical for every
+  /// value; block selection and creation, and scans with one touched block, stay serial.
+  int num_threads = 1;
 
   /// Every violated rule, one line each, naming the parameter and its valid range. Empty: valid.
   std::vector<std::string> validate() const;

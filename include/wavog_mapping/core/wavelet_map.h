@@ -6,7 +6,11 @@
 // resolution. Thread-safety: a map is not synchronised. Concurrent const calls on one map are safe;
 // any non-const call needs exclusive access to that map. integrate() keeps per-thread scratch
 // buffers (a thread_local, reused from scan to scan), so maps used from different threads never
-// share state, and each thread that integrates holds one scan's buffers for its lifetime.
+// share state, and each thread that integrates holds one scan's buffers for its lifetime. With
+// MapParams::num_threads != 1 a map owns worker threads (made on its first scan that touches two
+// blocks or more, kept until the map is destroyed, asleep between scans) that update the scan's
+// blocks together with the calling thread, reading its prepared scan; integrate() returns when
+// they are done, so the rules above are unchanged.
 #ifndef WAVOG_MAPPING_CORE_WAVELET_MAP_H_
 #define WAVOG_MAPPING_CORE_WAVELET_MAP_H_
 
