@@ -26,4 +26,22 @@ if(WAVOG_FUZZ)
   wavog_fuzzer(fuzz_map_load)
   wavog_fuzzer(fuzz_carmen)
   wavog_fuzzer(fuzz_integrate)
+
+  # 4: the node's message-to-core path (checkScan, time checks, tf placement, motion
+  # compensation, publication sizing) without a roscore: the ROS-layer sources it needs compiled
+  # here, against Debian's ROS headers (/usr/include; message structs are header-only) and the
+  # libraries of ros::Time and the tf buffer.
+  find_library(WAVOG_FUZZ_TF2 tf2)
+  find_library(WAVOG_FUZZ_ROSTIME rostime)
+  find_library(WAVOG_FUZZ_CONSOLE_BRIDGE console_bridge)
+  if(WAVOG_FUZZ_TF2 AND WAVOG_FUZZ_ROSTIME AND WAVOG_FUZZ_CONSOLE_BRIDGE
+     AND EXISTS /usr/include/sensor_msgs/LaserScan.h)
+    add_library(wavog_fuzz_node_glue STATIC src/ros/conversions.cpp src/ros/scan_placement.cpp)
+    target_link_libraries(wavog_fuzz_node_glue PUBLIC wavog_core ${WAVOG_FUZZ_TF2}
+      ${WAVOG_FUZZ_ROSTIME} ${WAVOG_FUZZ_CONSOLE_BRIDGE})
+    wavog_fuzzer(fuzz_node)
+    target_link_libraries(fuzz_node PRIVATE wavog_fuzz_node_glue)
+  else()
+    message(WARNING "fuzz_node not built: Debian's ROS headers or libtf2/librostime missing")
+  endif()
 endif()

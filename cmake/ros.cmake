@@ -23,7 +23,8 @@ if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/mapping_ros.cpp)
     src/ros/mapping_ros_publish.cpp
     src/ros/mapping_ros_diagnostics.cpp
     src/ros/mapping_ros_services.cpp
-    src/ros/mapping_ros_flush.cpp)
+    src/ros/mapping_ros_flush.cpp
+    src/ros/save_path.cpp)
   target_include_directories(wavog_ros SYSTEM PUBLIC ${WAVOG_ROS_INCLUDES})
   target_link_libraries(wavog_ros PUBLIC wavog_ros_config wavog_io wavog_core ${catkin_LIBRARIES})
   target_compile_options(wavog_ros PRIVATE ${WAVOG_WARNINGS})
@@ -63,6 +64,11 @@ if(CATKIN_ENABLE_TESTING)
       target_link_libraries(test_reconfigure wavog_ros ${GTEST_MAIN_LIBRARIES})
       add_dependencies(test_reconfigure ${PROJECT_NAME}_gencfg)
     endif()
+    # The node's limits (issue 16): time checks, publication sizing, save_map below map_dir.
+    catkin_add_gtest(test_node_limits test/ros/test_node_limits.cpp)
+    if(TARGET test_node_limits)
+      target_link_libraries(test_node_limits wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
   endif()
   if(TARGET wavog_mapping_node)
     find_package(rostest REQUIRED)
@@ -83,6 +89,15 @@ if(CATKIN_ENABLE_TESTING)
       target_link_libraries(test_bad_input ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
       add_dependencies(test_bad_input ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
     endif()
+
+    # Hostile input (issue 16): out-of-range time, huge read-outs, save_map outside map_dir,
+    # map_file not a regular file.
+    add_rostest_gtest(test_hostile_input test/hostile_input.test test/ros/test_hostile_input.cpp)
+    target_include_directories(test_hostile_input SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(test_hostile_input ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_hostile_input ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    target_compile_definitions(test_hostile_input PRIVATE
+      WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
 
     # Sim time jumping backwards (bag restart): tf buffer cleared, mapping goes on.
     add_rostest_gtest(test_clock_jump test/clock_jump.test test/ros/test_clock_jump.cpp)

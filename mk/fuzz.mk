@@ -7,7 +7,7 @@ FUZZ_CXX ?= $(shell command -v clang++-14 || command -v clang++)
 FUZZ_CC ?= $(shell command -v clang-14 || command -v clang)
 
 .PHONY: fuzz
-## libFuzzer harnesses (map loader, CARMEN reader, scan integration), FUZZ_SECONDS each.
+## libFuzzer harnesses (map loader, CARMEN reader, scan integration, node message path), FUZZ_SECONDS each.
 fuzz:
 	@bash $(ROOT)/scripts/install_deps.sh fuzz
 	@mkdir -p $(BUILD_FUZZ)

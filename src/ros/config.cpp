@@ -161,6 +161,7 @@ const std::vector<KeyReader>& readers() {
       {"motion_compensation",
        [](auto& k, auto& v, Config* c) { c->ros.motion_compensation = asBool(k, v); }},
       {"map_file", [](auto& k, auto& v, Config* c) { c->ros.map_file = asString(k, v); }},
+      {"map_dir", [](auto& k, auto& v, Config* c) { c->ros.map_dir = asString(k, v); }},
       {"rate_tolerance",
        [](auto& k, auto& v, Config* c) { c->ros.rate_tolerance = asDouble(k, v); }},
       {"idle_timeout", [](auto& k, auto& v, Config* c) { c->ros.idle_timeout = asDouble(k, v); }},
@@ -286,6 +287,9 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
         &e, "tf_cache_time (" + fmt(ros.tf_cache_time) + ") must be in [1, 3600] s");
   check(ros.queue_size >= 1 && ros.queue_size <= 1000, &e,
         "queue_size (" + std::to_string(ros.queue_size) + ") must be in [1, 1000]");
+  check(ros.map_dir.empty() || (ros.map_dir[0] == '/' && ("/" + ros.map_dir + "/").find("/../") ==
+                                                               std::string::npos),
+        &e, "map_dir ('" + ros.map_dir + "') must be an absolute path without '..' (empty: the ROS home)");
   check(std::isfinite(ros.rate_tolerance) && ros.rate_tolerance >= 0.0 && ros.rate_tolerance < 1.0,
         &e, "rate_tolerance (" + fmt(ros.rate_tolerance) + ") must be in [0, 1)");
   check(std::isfinite(ros.idle_timeout) && ros.idle_timeout >= 0.0 && ros.idle_timeout <= 3600.0,

@@ -4,16 +4,34 @@
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
 
+#include <algorithm>
 #include <boost/make_shared.hpp>
 #include <cmath>
 
 namespace wavog_ros {
+namespace {
+
+/// Cells of a box, in double (no overflow).
+double cells(const wavog::CellBox& b) {
+  return b.empty() ? 0.0 : static_cast<double>(b.width()) * static_cast<double>(b.height());
+}
+
+/// [lo, hi] clipped to [clip_lo, clip_hi]; false when empty or not finite.
+bool clip(double clip_lo, double clip_hi, double* lo, double* hi) {
+  *lo = std::max(*lo, clip_lo);
+  *hi = std::min(*hi, clip_hi);
+  return std::isfinite(*lo) && std::isfinite(*hi) && *lo <= *hi;
+}
+
+}  // namespace
+
 
 const char* toString(DropReason reason) {
   // In DropReason order.
   static constexpr const char* kNames[kNumDropReasons] = {
       "empty",          "size_mismatch", "bad_angles",    "bad_frame",
-      "tf_unavailable", "tf_too_old",    "no_valid_beam", "bad_geometry"};
+      "tf_unavailable", "tf_too_old",    "no_valid_beam", "bad_geometry",
+      "bad_time",       "exception"};
   const auto i = static_cast<std::size_t>(reason);
   return i < kNumDropReasons ? kNames[i] : "unknown";
 }
@@ -54,6 +72,49 @@ bool checkScan(const sensor_msgs::LaserScan& scan, DropReason* reason) {
   return true;
 }
 
+double secondsBetween(const ros::Time& a, const ros::Time& b) {
+  return (static_cast<double>(a.sec) - static_cast<double>(b.sec)) +
+         (static_cast<double>(a.nsec) - static_cast<double>(b.nsec)) * 1e-9;
+}
+
+bool addSeconds(const ros::Time& t, double seconds, ros::Time* out) {
+  if (!std::isfinite(seconds)) return false;
+  const double sum = t.toSec() + seconds;
+  // 2^32 - 1 s: one second short of the end of the range, so that rounding cannot reach it.
+  constexpr double kLast = 4294967295.0 - 1.0;
+  if (!(sum >= 0.0 && sum < kLast)) return false;
+  // Both now fit: the arithmetic of ros::Time cannot throw (|seconds| < 2^32 as well).
+  if (std::abs(seconds) >= 2147483647.0) {
+    out->fromSec(sum);  // a Duration of this length would not fit; the sum does
+  } else {
+    *out = t + ros::Duration(seconds);
+  }
+  return true;
+}
+
+bool tfStampUsable(const ros::Time& stamp, double cache_time) {
+  ros::Time ignored;
+  return addSeconds(stamp, std::max(0.0, cache_time), &ignored);
+}
+
+double sweepSeconds(const sensor_msgs::LaserScan& scan) {
+  if (scan.ranges.size() < 2) return 0.0;
+  return static_cast<double>(scan.time_increment) * static_cast<double>(scan.ranges.size() - 1);
+}
+
+bool checkScanTime(const sensor_msgs::LaserScan& scan, double tolerance, DropReason* reason) {
+  const double sweep = sweepSeconds(scan);
+  ros::Time ignored;
+  if (!std::isfinite(scan.time_increment) || !(std::abs(sweep) <= kMaxSweepSeconds) ||
+      !addSeconds(scan.header.stamp, std::max(0.0, tolerance), &ignored) ||
+      !addSeconds(scan.header.stamp, sweep, &ignored) ||
+      !addSeconds(scan.header.stamp, sweep + std::max(0.0, tolerance), &ignored)) {
+    *reason = DropReason::kBadTime;
+    return false;
+  }
+  return true;
+}
+
 wavog::ScanView toScanView(const sensor_msgs::LaserScan& scan) {
   wavog::ScanView v;
   v.ranges = scan.ranges.data();
@@ -81,6 +142,29 @@ wavog::Pose2 toPose2(const geometry_msgs::Transform& transform, bool* mirrored) 
 void mirrorView(wavog::ScanView* view) {
   view->angle_min = -view->angle_min;
   view->angle_increment = -view->angle_increment;
+}
+
+LayerSize layerBox(const wavog::WaveletMap& map, int scale, double window, double cx, double cy,
+                   wavog::CellBox* box) {
+  wavog::CellBox b;
+  if (!map.bounds(scale, &b) || b.empty()) return LayerSize::kEmpty;
+  if (window > 0.0) {
+    const double cell = std::ldexp(map.resolution(), scale);
+    const double bx0 = static_cast<double>(b.min_x) * cell, bx1 = static_cast<double>(b.max_x) * cell;
+    const double by0 = static_cast<double>(b.min_y) * cell, by1 = static_cast<double>(b.max_y) * cell;
+    double x0 = cx - window, x1 = cx + window, y0 = cy - window, y1 = cy + window;
+    if (!clip(bx0 - window, bx1 + window, &x0, &x1) || !clip(by0 - window, by1 + window, &y0, &y1)) {
+      return LayerSize::kEmpty;
+    }
+    if ((x1 - x0) / cell * ((y1 - y0) / cell) > kMaxLayerCells &&
+        (!clip(bx0, bx1, &x0, &x1) || !clip(by0, by1, &y0, &y1))) {
+      return LayerSize::kEmpty;
+    }
+    b = map.boxAround(x0, y0, x1, y1, scale);
+  }
+  *box = b;
+  if (b.empty()) return LayerSize::kEmpty;
+  return cells(b) > kMaxLayerCells ? LayerSize::kTooLarge : LayerSize::kOk;
 }
 
 nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,

@@ -5,6 +5,7 @@
 #include <nav_msgs/OccupancyGrid.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "wavog_mapping/io/map_files.h"
 #include "wavog_mapping/ros/conversions.h"
@@ -17,6 +18,13 @@ wavog::Raster emptyRaster(int scale, double resolution) {
   r.scale = scale;
   r.cell_size = resolution * static_cast<double>(1 << scale);
   return r;
+}
+
+/// [lo, hi] clipped to [clip_lo, clip_hi]; false when empty or not finite.
+bool clip(double clip_lo, double clip_hi, double* lo, double* hi) {
+  *lo = std::max(*lo, clip_lo);
+  *hi = std::min(*hi, clip_hi);
+  return std::isfinite(*lo) && std::isfinite(*hi) && *lo <= *hi;
 }
 
 }  // namespace
@@ -74,12 +82,11 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
   for (Layers::Layer& layer : out.layers) {
     // With a window, the read-out costs what the window holds, never the whole map.
     wavog::CellBox box;
-    bool have = true;
-    if (params.publish_window > 0.0) {
-      const double w = params.publish_window;
-      box = map.boxAround(cx - w, cy - w, cx + w, cy + w, layer.scale);
-    } else {
-      have = map.bounds(layer.scale, &box);
+    const LayerSize size = layerBox(map, layer.scale, params.publish_window, cx, cy, &box);
+    if (size == LayerSize::kTooLarge) {
+      out.refused.push_back("scale " + std::to_string(layer.scale) + ": " +
+                            std::to_string(box.width()) + " x " + std::to_string(box.height()) +
+                            " cells");
     }
     const wavog::Aggregation aggregation =
         layer.scale == 0 ? wavog::Aggregation::kMean : params.scale_aggregation;
@@ -87,7 +94,7 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
     // window may reach beyond what was seen; neither belongs in the message.
     wavog::CellBox known;
     layer.raster = emptyRaster(layer.scale, map.resolution());
-    if (have && !box.empty()) {
+    if (size == LayerSize::kOk) {
       wavog::Raster r = map.exportScale(layer.scale, box, aggregation);
       if (wavog::knownBox(r, &known)) layer.raster = wavog::cropToKnown(r, 0);
     }
@@ -112,13 +119,21 @@ bool MapPublisher::readUpdate(const wavog::WaveletMap& map, wavog::Raster* raste
                               wavog::CellBox* full) {
   if (!dirty_.any || !have_full_) return false;
   *full = last_full_box_;
-  const MapBox& d = dirty_.box;
+  // The dirty region clipped to the last full map in metres first: a scan's reach may be huge.
+  MapBox d = dirty_.box;
+  const double res = map.resolution();
+  dirty_.any = false;
+  if (!clip(static_cast<double>(full->min_x) * res, static_cast<double>(full->max_x) * res,
+            &d.min_x, &d.max_x) ||
+      !clip(static_cast<double>(full->min_y) * res, static_cast<double>(full->max_y) * res,
+            &d.min_y, &d.max_y)) {
+    return false;
+  }
   wavog::CellBox box = map.boxAround(d.min_x, d.min_y, d.max_x, d.max_y, 0);
   box.min_x = std::max(box.min_x, full->min_x);
   box.min_y = std::max(box.min_y, full->min_y);
   box.max_x = std::min(box.max_x, full->max_x);
   box.max_y = std::min(box.max_y, full->max_y);
-  dirty_.any = false;
   if (box.empty()) return false;
   *raster = map.exportScale(0, box, wavog::Aggregation::kMean);
   return true;

@@ -37,6 +37,7 @@ struct Layers {
     wavog::Raster raster;
   };
   std::vector<Layer> layers;
+  std::vector<std::string> refused;  ///< one line per layer larger than kMaxLayerCells
 };
 
 class MapPublisher {

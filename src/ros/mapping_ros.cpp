@@ -38,7 +38,7 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   if (!rp.map_file.empty()) {
     try {
       map_.load(rp.map_file);
-    } catch (const wavog::MapIoError& e) {
+    } catch (const std::exception& e) {  // MapIoError (not a regular file, corrupt, ...) or else
       throw std::runtime_error("map_file: cannot load '" + rp.map_file + "': " + e.what());
     }
     ROS_INFO("%s: loaded map_file '%s'", pnh_.getNamespace().c_str(), rp.map_file.c_str());
@@ -53,10 +53,7 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
                 [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseMapper(s); });
   for (const InputConfig& ic : rp.inputs) addInput(ic);
 
-  reset_srv_ = pnh_.advertiseService("reset", &Impl::onReset, this);
-  clear_srv_ = pnh_.advertiseService("clear_region", &Impl::onClearRegion, this);
-  save_srv_ = pnh_.advertiseService("save_map", &Impl::onSaveMap, this);
-  flush_srv_ = pnh_.advertiseService("flush", &Impl::onFlush, this);
+  advertiseServices();
   startReconfigure();
   startTimers();
 
@@ -86,7 +83,9 @@ void MappingRos::Impl::subscribeTf() {
     (is_static ? tf_static_sub_ : tf_sub_) = root.subscribe<tf2_msgs::TFMessage>(
         is_static ? "/tf_static" : "/tf", 100,
         boost::function<void(const tf2_msgs::TFMessage::ConstPtr&)>(
-            [this, is_static](const tf2_msgs::TFMessage::ConstPtr& m) { onTf(m, is_static); }),
+            [this, is_static](const tf2_msgs::TFMessage::ConstPtr& m) {
+              guarded("tf callback", nullptr, [&] { onTf(m, is_static); });
+            }),
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   }
 }
@@ -106,16 +105,21 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
                                             static_cast<std::uint32_t>(rp.queue_size), nh_);
   in->filter->setTolerance(ros::Duration(rp.tf_tolerance));
   in->filter->registerCallback(boost::function<void(const LaserScan::ConstPtr&)>(
-      [this, raw](const LaserScan::ConstPtr& scan) { onTransformable(raw, scan); }));
+      [this, raw](const LaserScan::ConstPtr& scan) {
+        guarded("scan integration", raw, [&] { onTransformable(raw, scan); });
+      }));
   in->filter->registerFailureCallback(
       boost::function<void(const LaserScan::ConstPtr&, FailureReason)>(
           [this, raw](const LaserScan::ConstPtr& scan, FailureReason reason) {
-            onFilterFailure(raw, scan, reason);
+            guarded("tf filter failure callback", nullptr,
+                    [&] { onFilterFailure(raw, scan, reason); });
           }));
   in->sub = nh_.subscribe<LaserScan>(
       ic.topic, kSubscriberQueue,
       boost::function<void(const LaserScan::ConstPtr&)>(
-          [this, raw](const LaserScan::ConstPtr& scan) { onScan(raw, scan); }),
+          [this, raw](const LaserScan::ConstPtr& scan) {
+            guarded("scan callback", raw, [&] { onScan(raw, scan); });
+          }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   updater_->add(in->topic + " input", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {
     diagnoseInput(raw, s);
@@ -135,26 +139,36 @@ void MappingRos::Impl::startReconfigure() {
   // The server starts from the loaded configuration (not from the .cfg defaults, which are only
   // the "forget" policy's).
   reconfigure_ = std::make_unique<ReconfigureServer>(
-      pnh_, toReconfigure(config_),
-      [this](const wavog_mapping::MappingConfig& rc) { return onReconfigure(rc); });
+      pnh_, toReconfigure(config_), [this](const wavog_mapping::MappingConfig& rc) {
+        std::vector<std::string> errors = {"internal error (logged)"};
+        guarded("reconfigure callback", nullptr, [&] { errors = onReconfigure(rc); });
+        return errors;
+      });
 }
 
 void MappingRos::Impl::startTimers() {
   const RosParams& rp = config_.ros;
   last_status_time_ = ros::Time::now();
-  publish_timer_ =
-      nh_.createTimer(ros::Duration(1.0 / rp.publish_rate), &Impl::onPublishTimer, this);
+  publish_timer_ = nh_.createTimer(ros::Duration(1.0 / rp.publish_rate),
+                                   [this](const ros::TimerEvent& e) {
+                                     guarded("publish timer", nullptr, [&] { onPublishTimer(e); });
+                                   });
   if (rp.update_rate > 0.0) {
-    update_timer_ =
-        nh_.createTimer(ros::Duration(1.0 / rp.update_rate), &Impl::onUpdateTimer, this);
+    update_timer_ = nh_.createTimer(ros::Duration(1.0 / rp.update_rate),
+                                    [this](const ros::TimerEvent& e) {
+                                      guarded("update timer", nullptr, [&] { onUpdateTimer(e); });
+                                    });
   }
-  diag_timer_ = nh_.createTimer(ros::Duration(kDiagnosticsPeriod),
-                                [this](const ros::TimerEvent&) { updater_->update(); });
+  diag_timer_ = nh_.createTimer(ros::Duration(kDiagnosticsPeriod), [this](const ros::TimerEvent&) {
+    guarded("diagnostics timer", nullptr, [&] { updater_->update(); });
+  });
   if (rp.idle_timeout > 0.0) {
     // Wall time: with use_sim_time the clock stops with the bag, and ROS timers with it.
     noteActivity();
     idle_timer_ = nh_.createWallTimer(ros::WallDuration(std::min(0.25, rp.idle_timeout / 4.0)),
-                                      &Impl::onIdleTimer, this);
+                                      [this](const ros::WallTimerEvent& e) {
+                                        guarded("idle timer", nullptr, [&] { onIdleTimer(e); });
+                                      });
   }
 }
 

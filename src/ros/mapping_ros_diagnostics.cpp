@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "mapping_ros_impl.h"
+#include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_ros {
 namespace {
@@ -20,7 +21,7 @@ void MappingRos::Impl::diagnoseInput(const Input* in,
                                      diagnostic_updater::DiagnosticStatusWrapper& stat) {
   std::lock_guard<std::mutex> lock(mutex_);
   const InputCounters& c = in->c;
-  const double since = (ros::Time::now() - c.last_receipt).toSec();
+  const double since = secondsBetween(ros::Time::now(), c.last_receipt);
   const double expected = in->config.expected_rate;
   const double stale_after = expected > 0.0 ? kStalePeriods / expected : kStalePeriods;
   if (c[Counter::kReceived] == 0) {
@@ -58,6 +59,9 @@ void MappingRos::Impl::diagnoseMapper(diagnostic_updater::DiagnosticStatusWrappe
   }
   stat.add("tf failures", tf_failures);
   stat.add("clock jumps", clock_jumps_);
+  stat.add("exceptions caught", exceptions_);
+  stat.add("layers refused (too large)", layers_refused_);
+  stat.add("transforms refused", tf_refused_);
   stat.add("integration time mean (s)", last_mean_);
   stat.add("integration time max (s)", last_max_);
   stat.add("publish time (s)", publish_time_);

@@ -87,6 +87,22 @@ struct MappingRos::Impl {
   void dropLocked(Input* in, DropReason reason, const std::string& detail);
   void warnLocked(Input* in, std::size_t slot, const std::string& text);
 
+  // ---- what no callback, timer or service lets escape (mapping_ros_scans.cpp)
+  /// Counts an exception caught in `where` (and, with an input, the scan as dropped), throttled
+  /// ROS_ERROR. Takes the lock itself: call it with mutex_ released.
+  void caught(const char* where, const char* what, Input* in);
+  /// Runs f(), catching and counting (caught()) whatever it throws.
+  template <typename F>
+  void guarded(const char* where, Input* in, F&& f) {
+    try {
+      f();
+    } catch (const std::exception& e) {
+      caught(where, e.what(), in);
+    } catch (...) {
+      caught(where, "unknown exception", in);
+    }
+  }
+
   // ---- the end of the input (mapping_ros_flush.cpp)
   /// Input stopped for idle_timeout (wall time: a bag's clock stops with it): flush, publish.
   void onIdleTimer(const ros::WallTimerEvent&);
@@ -108,6 +124,7 @@ struct MappingRos::Impl {
   void diagnoseMapper(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   // ---- services (mapping_ros_services.cpp)
+  void advertiseServices();  ///< each handler guarded: an exception is a failed answer, counted
   bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
   bool onClearRegion(wavog_mapping::ClearRegion::Request& req,
                      wavog_mapping::ClearRegion::Response& res);
@@ -136,6 +153,9 @@ struct MappingRos::Impl {
   std::vector<std::unique_ptr<Input>> inputs_;
   ros::Time last_now_;  ///< clock at the last scan (backwards-jump check)
   std::uint64_t clock_jumps_ = 0;
+  std::uint64_t exceptions_ = 0;      ///< caught by guarded()
+  std::uint64_t layers_refused_ = 0;  ///< layers larger than kMaxLayerCells, not published
+  std::uint64_t tf_refused_ = 0;      ///< transforms the tf buffer could not take
   // Integration time over the current status period.
   double integrate_time_sum_ = 0.0;
   double integrate_time_max_ = 0.0;

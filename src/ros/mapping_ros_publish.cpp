@@ -44,7 +44,17 @@ void MappingRos::Impl::publishAll() {
       layers = publisher_->read(map_, rp, cx, cy);
       changed_since_publish_ = false;
     }
+    layers_refused_ += layers.refused.size();
     status = statusLocked(now);
+  }
+  if (!layers.refused.empty()) {
+    std::string text;
+    for (const auto& r : layers.refused) text += " " + r + ";";
+    ROS_ERROR_THROTTLE(kWarnPeriod,
+                       "%s: layers not published, more than %.0f cells (the limit of one layer):%s "
+                       "set publish_window to publish a square around '%s'",
+                       pnh_.getNamespace().c_str(), kMaxLayerCells, text.c_str(),
+                       rp.base_frame.c_str());
   }
   MapPublisher::publish(layers, rp.map_frame, now);
   status_pub_.publish(status);
@@ -56,7 +66,7 @@ void MappingRos::Impl::publishAll() {
 
 wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time& now) {
   auto status = boost::make_shared<wavog_mapping::MapperStatus>();
-  const double period = (now - last_status_time_).toSec();
+  const double period = secondsBetween(now, last_status_time_);  // a /clock may be anything
   last_status_time_ = now;
   status->header.stamp = now;
   status->header.frame_id = config_.ros.map_frame;
@@ -69,6 +79,9 @@ wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time&
     status->tf_failures += c.tfFailures();
   }
   status->clock_jumps = clock_jumps_;
+  status->exceptions = exceptions_;
+  status->layers_refused = layers_refused_;
+  status->tf_refused = tf_refused_;
   last_mean_ =
       integrate_count_ > 0 ? integrate_time_sum_ / static_cast<double>(integrate_count_) : 0.0;
   last_max_ = integrate_time_max_;

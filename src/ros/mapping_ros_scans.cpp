@@ -68,7 +68,7 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
     c.last_receipt = now;
     // The clock jumping backwards (a bag restarted with --clock): the tf buffer holds the old
     // future and would refuse every new scan, so clear it and go on.
-    if (!last_now_.isZero() && (last_now_ - now).toSec() > kTimeJumpThreshold) {
+    if (!last_now_.isZero() && secondsBetween(last_now_, now) > kTimeJumpThreshold) {
       ++clock_jumps_;
       clear_tf = true;
     }
@@ -76,7 +76,7 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
     // Stamps jumping backwards on one input (a bag restarted without --clock, a driver reset):
     // counted and warned; such a scan is placed by tf if its stamp is still in the buffer, else
     // dropped as too old.
-    const double back = (c.last_received_stamp - scan->header.stamp).toSec();
+    const double back = secondsBetween(c.last_received_stamp, scan->header.stamp);
     if (!c.last_received_stamp.isZero() && back > kTimeJumpThreshold) {
       ++c[Counter::kTimeJumps];
       warnLocked(in, kOtherWarning, "stamp jumped backwards by " + std::to_string(back) + " s");
@@ -88,6 +88,16 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
       detail << "frame_id '" << scan->header.frame_id << "', " << scan->ranges.size()
              << " ranges, angles [" << scan->angle_min << ", " << scan->angle_max << "] step "
              << scan->angle_increment;
+      dropLocked(in, reason, detail.str());
+      return;
+    }
+    // Before the tf filter, which adds tf_tolerance to the stamp (and would throw).
+    if (!checkScanTime(*scan, config_.ros.tf_tolerance, &reason)) {
+      std::ostringstream detail;
+      detail << "stamp " << scan->header.stamp.sec << "." << scan->header.stamp.nsec
+             << " s, time_increment " << scan->time_increment << " s over "
+             << scan->ranges.size() << " beams (sweep at most " << kMaxSweepSeconds
+             << " s, stamps within ROS time)";
       dropLocked(in, reason, detail.str());
       return;
     }
@@ -103,14 +113,31 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
 
 void MappingRos::Impl::onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static) {
   noteActivity();
-  std::lock_guard<std::mutex> tf_lock(tf_mutex_);
-  for (const auto& t : msg->transforms) {
-    try {
-      buffer_->setTransform(t, "default_authority", is_static);
-    } catch (const tf2::TransformException& e) {
-      ROS_WARN_THROTTLE(kWarnPeriod, "%s: transform refused by the tf buffer: %s",
-                        pnh_.getNamespace().c_str(), e.what());
+  std::uint64_t refused = 0;
+  {
+    std::lock_guard<std::mutex> tf_lock(tf_mutex_);
+    for (const auto& t : msg->transforms) {
+      // The buffer's pruning adds its cache length to the stamp and would throw.
+      if (!tfStampUsable(t.header.stamp, config_.ros.tf_cache_time)) {
+        ++refused;
+        ROS_WARN_THROTTLE(kWarnPeriod, "%s: transform %s -> %s refused: stamp %u.%09u s is too late for ROS time",
+                          pnh_.getNamespace().c_str(), t.header.frame_id.c_str(),
+                          t.child_frame_id.c_str(), t.header.stamp.sec, t.header.stamp.nsec);
+        continue;
+      }
+      try {
+        // false: refused (NaN, empty or equal frame ids...; tf2 logs why).
+        if (!buffer_->setTransform(t, "default_authority", is_static)) ++refused;
+      } catch (const tf2::TransformException& e) {
+        ++refused;
+        ROS_WARN_THROTTLE(kWarnPeriod, "%s: transform refused by the tf buffer: %s",
+                          pnh_.getNamespace().c_str(), e.what());
+      }
     }
+  }
+  if (refused > 0) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tf_refused_ += refused;
   }
 }
 
@@ -183,6 +210,17 @@ void MappingRos::Impl::dropLocked(Input* in, DropReason reason, const std::strin
   warnLocked(in, static_cast<std::size_t>(reason),
              "scan dropped (" + std::string(toString(reason)) + ", " + std::to_string(n) +
                  " so far): " + detail);
+}
+
+void MappingRos::Impl::caught(const char* where, const char* what, Input* in) {
+  std::uint64_t n = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    n = ++exceptions_;
+    if (in != nullptr) ++in->c[droppedCounter(DropReason::kException)];
+  }
+  ROS_ERROR_THROTTLE(kWarnPeriod, "%s: exception caught in the %s (%llu so far), going on: %s",
+                     pnh_.getNamespace().c_str(), where, static_cast<unsigned long long>(n), what);
 }
 
 void MappingRos::Impl::warnLocked(Input* in, std::size_t slot, const std::string& text) {

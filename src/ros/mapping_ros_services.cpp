@@ -9,10 +9,43 @@
 #include <system_error>
 
 #include "mapping_ros_impl.h"
+#include "save_path.h"
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/io/map_files.h"
 
 namespace wavog_ros {
+
+void MappingRos::Impl::advertiseServices() {
+  using wavog_mapping::ClearRegion;
+  using wavog_mapping::SaveMap;
+  reset_srv_ = pnh_.advertiseService<std_srvs::Empty::Request, std_srvs::Empty::Response>(
+      "reset", [this](std_srvs::Empty::Request& req, std_srvs::Empty::Response& res) {
+        bool ok = false;
+        guarded("reset service", nullptr, [&] { ok = onReset(req, res); });
+        return ok;
+      });
+  clear_srv_ = pnh_.advertiseService<ClearRegion::Request, ClearRegion::Response>(
+      "clear_region", [this](ClearRegion::Request& req, ClearRegion::Response& res) {
+        res.success = false;
+        res.message = "internal error (logged)";
+        guarded("clear_region service", nullptr, [&] { onClearRegion(req, res); });
+        return true;
+      });
+  save_srv_ = pnh_.advertiseService<SaveMap::Request, SaveMap::Response>(
+      "save_map", [this](SaveMap::Request& req, SaveMap::Response& res) {
+        res.success = false;
+        res.message = "internal error (logged)";
+        guarded("save_map service", nullptr, [&] { onSaveMap(req, res); });
+        return true;
+      });
+  flush_srv_ = pnh_.advertiseService<std_srvs::Trigger::Request, std_srvs::Trigger::Response>(
+      "flush", [this](std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res) {
+        res.success = false;
+        res.message = "internal error (logged)";
+        guarded("flush service", nullptr, [&] { onFlush(req, res); });
+        return true;
+      });
+}
 
 bool MappingRos::Impl::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -42,42 +75,48 @@ bool MappingRos::Impl::onClearRegion(wavog_mapping::ClearRegion::Request& req,
 
 bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
                                  wavog_mapping::SaveMap::Response& res) {
-  if (req.path.empty()) {
+  // Every refusal and failure is logged as well as answered.
+  const auto fail = [this, &res](const std::string& message) {
     res.success = false;
-    res.message = "path is empty";
+    res.message = message;
+    ROS_ERROR("%s: save_map failed: %s", pnh_.getNamespace().c_str(), message.c_str());
     return true;
-  }
+  };
+  std::string resolved, refusal;
+  if (!resolveSavePath(config_.ros.map_dir, req.path, &resolved, &refusal)) return fail(refusal);
+  req.path = resolved;  // below map_dir; relative names resolved under it
   // The folder is created when missing; images go beside the map file as wavog_offline names
   // them: <stem>_s<scale>.pgm/.yaml, <stem> being the path without its extension.
   const std::filesystem::path dir = std::filesystem::path(req.path).parent_path();
   if (!dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
-    if (ec) {
-      res.success = false;
-      res.message = "cannot create the folder '" + dir.string() + "': " + ec.message();
-      return true;
-    }
+    if (ec) return fail("cannot create the folder '" + dir.string() + "': " + ec.message());
   }
   const std::string stem = wavog::pathStem(req.path);
   // Scans still waiting for tf belong to the saved map (at the end of a bag they would wait
   // forever).
   flushPending();
   std::vector<wavog::Raster> rasters;
+  std::string refused;  // layers too large for an image
   {
     std::lock_guard<std::mutex> lock(mutex_);
     try {
       map_.save(req.path);
     } catch (const wavog::MapIoError& e) {
-      res.success = false;
-      res.message = e.what();
-      return true;
+      return fail(e.what());
     }
     std::vector<int> scales = {0};
     for (int s : publisher_->scales()) scales.push_back(s);
     for (int s : scales) {
       wavog::CellBox box;
-      if (map_.bounds(s, &box) && !box.empty()) {
+      const LayerSize size = layerBox(map_, s, 0.0, 0.0, 0.0, &box);
+      if (size == LayerSize::kTooLarge) {
+        ++layers_refused_;
+        refused += " scale " + std::to_string(s) + " (" + std::to_string(box.width()) + " x " +
+                   std::to_string(box.height()) + " cells)";
+      }
+      if (size == LayerSize::kOk) {
         rasters.push_back(wavog::cropToKnown(map_.exportScale(
             s, box, s == 0 ? wavog::Aggregation::kMean : config_.ros.scale_aggregation)));
       }
@@ -91,12 +130,15 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
       res.files.push_back(wavog::writeMapServerMap(base, r));
     }
   } catch (const std::exception& e) {
-    res.success = false;
-    res.message = e.what();
-    return true;
+    return fail(e.what());
   }
   res.success = true;
   res.message = "saved " + std::to_string(res.files.size()) + " files";
+  if (!refused.empty()) {
+    res.message += "; no image of" + refused + ": more than " +
+                   std::to_string(static_cast<long long>(kMaxLayerCells)) + " cells";
+    ROS_ERROR("%s: save_map: %s", pnh_.getNamespace().c_str(), res.message.c_str());
+  }
   ROS_INFO("%s: map saved to %s (+ %zu map_server images)", pnh_.getNamespace().c_str(),
            req.path.c_str(), rasters.size());
   publishAll();  // the saved map is also the published one

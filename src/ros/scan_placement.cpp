@@ -24,7 +24,7 @@ ScanPlacement placeScan(const tf2::BufferCore& tf, const sensor_msgs::LaserScan&
     p.failure = TfFailure::kExtrapolation;
     p.error = e.what();
     return p;
-  } catch (const tf2::TransformException& e) {
+  } catch (const std::exception& e) {  // tf2::TransformException, or anything tf throws
     p.failure = TfFailure::kUnavailable;
     p.error = e.what();
     return p;
@@ -36,15 +36,20 @@ ScanPlacement placeScan(const tf2::BufferCore& tf, const sensor_msgs::LaserScan&
       scan.time_increment == 0.0f) {
     return p;
   }
-  const double sweep = static_cast<double>(scan.time_increment) * static_cast<double>(n - 1);
+  // checkScanTime() refuses the sweeps ROS time cannot represent; here they only skip the
+  // compensation, so that this function never throws.
+  ros::Time end_stamp;
+  if (!(std::abs(sweepSeconds(scan)) <= kMaxSweepSeconds) ||
+      !addSeconds(scan.header.stamp, sweepSeconds(scan), &end_stamp)) {
+    p.motion_fallback = true;
+    return p;
+  }
   try {
     bool mirrored_end = false;
-    p.end = toPose2(
-        tf.lookupTransform(options.fixed_frame, frame, scan.header.stamp + ros::Duration(sweep))
-            .transform,
-        &mirrored_end);
+    p.end = toPose2(tf.lookupTransform(options.fixed_frame, frame, end_stamp).transform,
+                    &mirrored_end);
     p.compensate = true;
-  } catch (const tf2::TransformException&) {
+  } catch (const std::exception&) {
     p.end = p.start;
     p.motion_fallback = true;
   }

@@ -57,6 +57,9 @@ struct RosParams {
   bool motion_compensation = true;
   /// Native map file loaded at start-up; empty: start with an empty map.
   std::string map_file;
+  /// Directory ~save_map writes below (absolute, no '..'); relative paths resolve under it.
+  /// Empty: the ROS home ($ROS_HOME, else ~/.ros).
+  std::string map_dir;
   /// Relative tolerance of the diagnostics' rate check, in [0, 1).
   double rate_tolerance = 0.5;
   /// Wall time (s) without any scan or tf after which the input counts as stopped (the end of a

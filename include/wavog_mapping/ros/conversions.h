@@ -26,8 +26,33 @@ enum class DropReason {
   kTfTooOld,       ///< stamp older than the tf buffer
   kNoValidBeam,    ///< every beam invalid (REP 117): nothing to integrate
   kBadGeometry,    ///< refused by the core (bad range limits, non-finite pose, ...)
+  kBadTime,        ///< stamp or time_increment outside what ROS time arithmetic can represent
+  kException,      ///< an exception was caught while handling the scan (logged)
 };
-constexpr std::size_t kNumDropReasons = 8;
+constexpr std::size_t kNumDropReasons = 10;
+
+/// Longest sweep (s), |time_increment| x (beams - 1), of a scan that is accepted; a longer one, or
+/// a non-finite time_increment, is dropped as bad_time. Planar lasers sweep in 10-200 ms.
+constexpr double kMaxSweepSeconds = 10.0;
+
+/// a - b in seconds. Never throws (ros::Time's operator- throws beyond 2^31 s).
+double secondsBetween(const ros::Time& a, const ros::Time& b);
+
+/// t + seconds into *out; false (and *out untouched) when seconds is non-finite or the sum falls
+/// outside [0, 2^32) s, where ros::Time arithmetic would throw. Never throws.
+bool addSeconds(const ros::Time& t, double seconds, ros::Time* out);
+
+/// Whether the tf buffer can take a transform stamped `stamp` with a cache of `cache_time` s: its
+/// pruning adds cache_time to the stamps and throws beyond 2^32 s. Never throws.
+bool tfStampUsable(const ros::Time& stamp, double cache_time);
+
+/// Sweep duration (s) of a scan: time_increment x (beams - 1); 0 for fewer than 2 beams.
+double sweepSeconds(const sensor_msgs::LaserScan& scan);
+
+/// Checks the time fields of a scan that passed checkScan(): the stamp plus `tolerance` (the tf
+/// filter's) and plus the sweep must be representable, time_increment finite and the sweep at
+/// most kMaxSweepSeconds. Returns false and sets *reason (kBadTime) otherwise. Never throws.
+bool checkScanTime(const sensor_msgs::LaserScan& scan, double tolerance, DropReason* reason);
 
 /// Short name of a drop reason ("empty", "size_mismatch", ...).
 const char* toString(DropReason reason);
@@ -53,6 +78,22 @@ wavog::Pose2 toPose2(const geometry_msgs::Transform& transform, bool* mirrored);
 
 /// Mirrors a view's bearings (angle_min and angle_increment change sign).
 void mirrorView(wavog::ScanView* view);
+
+/// Most cells of one published layer or saved image: 2^24 (16.8 M cells, e.g. 4096 x 4096, about
+/// 100 MB while it is read out and sent). A larger layer is refused (counted, logged), never
+/// allocated; publish_window bounds what is published.
+constexpr double kMaxLayerCells = 16777216.0;
+
+/// What layerBox() found.
+enum class LayerSize { kEmpty, kOk, kTooLarge };
+
+/// The box of scale-s cells one layer publishes: the map's bounds (window <= 0), or the square of
+/// half-width `window` around (cx, cy), clipped to the bounds grown by the window (no change while
+/// the robot is on the map; a centre far off the map, or not finite, gives an empty layer) and,
+/// when it would hold more than kMaxLayerCells, to the bounds. kTooLarge (*box the refused box)
+/// when the result holds more than kMaxLayerCells. Allocates nothing, never throws.
+LayerSize layerBox(const wavog::WaveletMap& map, int scale, double window, double cx, double cy,
+                   wavog::CellBox* box);
 
 /// The raster as an OccupancyGrid in `frame` (origin = raster origin, identity orientation,
 /// row-major from the lowest y, -1 unknown, 0..100 graded).

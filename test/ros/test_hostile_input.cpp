@@ -1,0 +1,266 @@
+// Hostile input (issue 16, node side): each case is sent alone, then a good scan; the node must
+// stay up, count the case under its reason, and map the good scan. Cases: time_increment 1e7,
+// 1e30 and NaN, a stamp of {2^32 - 1 s, 999999999 ns}, a stamp far in the future (the next good
+// scan is 2^31 s back), a /tf transform stamped 2^32 - 1 s (the tf buffer's pruning would throw:
+// refused, counted in tf_refused), lasers placed by tf 2e5 m apart (a read-out of 1.6e13 cells: the layers
+// are refused, not allocated), save_map outside map_dir ('..', absolute, through a symlink), and
+// a map_file that is /dev/zero, a FIFO or a directory (start-up fails at once, naming it).
+// No exception may have been needed to survive: ~status.exceptions stays 0.
+#include <gtest/gtest.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <std_srvs/Empty.h>
+#include <sys/stat.h>
+#include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <limits>
+#include <mutex>
+#include <string>
+
+#include "room.h"
+#include "wavog_mapping/MapperStatus.h"
+#include "wavog_mapping/SaveMap.h"
+
+namespace {
+
+using wavog_mapping::InputStatus;
+using wavog_mapping::MapperStatus;
+
+std::mutex g_mutex;
+nav_msgs::OccupancyGrid::ConstPtr g_map;
+MapperStatus::ConstPtr g_status;
+ros::Publisher g_scan_pub;
+ros::Publisher g_tf_pub;  ///< /tf, for a hostile transform
+
+/// base_link -> far_plus / far_minus: lasers 2e5 m either side of the robot.
+constexpr double kFar = 2e5;
+
+MapperStatus::ConstPtr latestStatus() {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  return g_status;
+}
+
+/// Waits until the status satisfies `pred`; returns the last status (may fail `pred`).
+template <typename Pred>
+MapperStatus::ConstPtr waitStatus(Pred pred, double timeout = 20.0) {
+  return room::waitLatest(
+      &g_mutex, &g_status,
+      [&pred](const MapperStatus& s) { return s.inputs.size() == 1 && pred(s); }, timeout);
+}
+
+sensor_msgs::LaserScan::Ptr good() { return room::scanOf(room::sensors()[0], ros::Time::now()); }
+
+/// Sends a good scan and waits until the node has integrated more than `integrated` scans.
+MapperStatus::ConstPtr goodScanIntegrated(std::uint64_t integrated) {
+  g_scan_pub.publish(good());
+  return waitStatus([&](const MapperStatus& s) { return s.inputs[0].integrated > integrated; });
+}
+
+/// Sends `bad`, then a good scan; checks that `counter` of the input grew by one and that the
+/// good scan was integrated (after `bad` itself when `bad_integrated`).
+void sendCase(const std::string& name, const sensor_msgs::LaserScan::Ptr& bad,
+              std::uint64_t InputStatus::*counter, bool bad_integrated = false) {
+  SCOPED_TRACE(name);
+  const auto before = latestStatus();
+  ASSERT_TRUE(before);
+  const std::uint64_t count = before->inputs[0].*counter;
+  const std::uint64_t integrated = before->inputs[0].integrated + (bad_integrated ? 2 : 1);
+  g_scan_pub.publish(bad);
+  ros::WallDuration(0.1).sleep();
+  g_scan_pub.publish(good());
+  const auto after = waitStatus([&](const MapperStatus& s) {
+    return s.inputs[0].integrated >= integrated && s.inputs[0].*counter > count;
+  });
+  ASSERT_TRUE(after);
+  EXPECT_EQ(after->inputs[0].*counter, count + 1) << name << " not counted";
+  EXPECT_GE(after->inputs[0].integrated, integrated) << "the good scan after " << name;
+  EXPECT_EQ(after->exceptions, 0u);
+}
+
+class Hostile : public testing::Test {
+ protected:
+  void SetUp() override {
+    // The node is up and mapping (and has taken these scans before the case starts).
+    const auto s = latestStatus();
+    const std::uint64_t integrated = s && s->inputs.size() == 1 ? s->inputs[0].integrated : 0;
+    for (int i = 0; i < 3; ++i) {
+      g_scan_pub.publish(good());
+      ros::WallDuration(0.1).sleep();
+    }
+    ASSERT_TRUE(waitStatus(
+        [&](const MapperStatus& st) { return st.inputs[0].integrated >= integrated + 3; }));
+  }
+};
+
+TEST_F(Hostile, TimeOutOfRangeDroppedAsBadTime) {
+  auto ti_1e7 = good();
+  ti_1e7->time_increment = 1e7f;
+  sendCase("time_increment 1e7", ti_1e7, &InputStatus::dropped_bad_time);
+
+  auto ti_1e30 = good();
+  ti_1e30->time_increment = 1e30f;
+  sendCase("time_increment 1e30", ti_1e30, &InputStatus::dropped_bad_time);
+
+  auto ti_nan = good();
+  ti_nan->time_increment = std::numeric_limits<float>::quiet_NaN();
+  sendCase("time_increment NaN", ti_nan, &InputStatus::dropped_bad_time);
+
+  auto last_stamp = good();
+  last_stamp->header.stamp.sec = 4294967295u;
+  last_stamp->header.stamp.nsec = 999999999u;
+  sendCase("stamp {4294967295, 999999999}", last_stamp, &InputStatus::dropped_bad_time);
+}
+
+TEST_F(Hostile, StampFarFromThePreviousOneCountedAsTimeJump) {
+  // 4e9 s is representable (static tf places it); the next good scan is 2.2e9 s back, beyond
+  // what a ros::Duration holds.
+  auto future = good();
+  future->header.stamp = ros::Time(4000000000u, 0);
+  sendCase("stamp 4e9 s", future, &InputStatus::time_jumps, /*bad_integrated=*/true);
+}
+
+TEST_F(Hostile, TransformStampedAtTheEndOfTimeRefused) {
+  // The tf buffer's pruning adds tf_cache_time to this stamp: out of ROS time, it would throw.
+  const auto before = latestStatus();
+  ASSERT_TRUE(before);
+  room::waitForSubscribers(g_tf_pub, 1, 10.0);
+  tf2_msgs::TFMessage msg;
+  msg.transforms.push_back(
+      room::toMsg(room::sensorInBase(room::sensors()[0]), "base_link", "late_laser"));
+  msg.transforms[0].header.stamp.sec = 4294967295u;
+  msg.transforms[0].header.stamp.nsec = 0;
+  g_tf_pub.publish(msg);
+  ros::WallDuration(0.2).sleep();
+  const auto after = goodScanIntegrated(before->inputs[0].integrated);
+  ASSERT_TRUE(after);
+  const auto s = waitStatus([&](const MapperStatus& st) { return st.tf_refused > before->tf_refused; });
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->tf_refused, before->tf_refused + 1);
+  EXPECT_EQ(s->exceptions, 0u);
+}
+
+TEST_F(Hostile, HugeReadOutRefusedNotAllocated) {
+  const auto before = latestStatus();
+  ASSERT_TRUE(before);
+  const std::uint64_t integrated = before->inputs[0].integrated;
+  for (const char* frame : {"far_plus", "far_minus"}) {
+    auto scan = good();
+    scan->header.frame_id = frame;
+    g_scan_pub.publish(scan);
+    ros::WallDuration(0.1).sleep();
+  }
+  auto s = waitStatus([&](const MapperStatus& st) {
+    return st.inputs[0].integrated >= integrated + 2 && st.layers_refused > 0;
+  });
+  ASSERT_TRUE(s);
+  EXPECT_GE(s->inputs[0].integrated, integrated + 2);
+  EXPECT_GT(s->layers_refused, 0u) << "a map 4e5 m wide must not be published whole";
+  EXPECT_EQ(s->exceptions, 0u);
+
+  // save_map: the native map is written, the images are refused (too large).
+  wavog_mapping::SaveMap save;
+  save.request.path = "wavog_hostile_huge_" + std::to_string(getpid()) + ".wavog";
+  ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", save));
+  EXPECT_TRUE(save.response.success) << save.response.message;
+  EXPECT_NE(save.response.message.find("no image"), std::string::npos) << save.response.message;
+  for (const auto& f : save.response.files) std::remove(f.c_str());
+
+  // After a reset the node maps again.
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::call("wavog_mapping/reset", reset));
+  s = goodScanIntegrated(s->inputs[0].integrated);
+  ASSERT_TRUE(s);
+  const ros::Time after = ros::Time::now();
+  const auto map = room::waitLatest(
+      &g_mutex, &g_map, [&](const nav_msgs::OccupancyGrid& g) { return g.header.stamp > after; },
+      10.0);
+  ASSERT_TRUE(map);
+  EXPECT_GT(room::cellAt(*map, room::kOccX, room::kOccY), 65) << "the good scan is mapped";
+  EXPECT_LT(map->info.width, 1000u);
+}
+
+TEST_F(Hostile, SaveMapOnlyBelowMapDir) {
+  const std::string pid = std::to_string(getpid());
+  const std::string link = "/tmp/wavog_hostile_link_" + pid;
+  ASSERT_EQ(::symlink("/etc", link.c_str()), 0);
+  for (const std::string& path :
+       {std::string("../wavog_hostile_") + pid + ".wavog", "/etc/wavog_hostile_" + pid + ".wavog",
+        "wavog_hostile_link_" + pid + "/x.wavog", std::string("/tmp")}) {
+    SCOPED_TRACE(path);
+    wavog_mapping::SaveMap save;
+    save.request.path = path;
+    ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", save));
+    EXPECT_FALSE(save.response.success);
+    EXPECT_NE(save.response.message.find("refused"), std::string::npos) << save.response.message;
+    EXPECT_TRUE(save.response.files.empty());
+  }
+  ::unlink(link.c_str());
+  // A relative name resolves below map_dir (/tmp).
+  wavog_mapping::SaveMap save;
+  save.request.path = "wavog_hostile_" + pid + ".wavog";
+  ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", save));
+  ASSERT_TRUE(save.response.success) << save.response.message;
+  ASSERT_FALSE(save.response.files.empty());
+  EXPECT_EQ(save.response.files[0], "/tmp/wavog_hostile_" + pid + ".wavog");
+  struct stat st {};
+  EXPECT_EQ(::stat(save.response.files[0].c_str(), &st), 0);
+  for (const auto& f : save.response.files) std::remove(f.c_str());
+}
+
+/// Runs a command, returns its exit status; *output gets stdout and stderr.
+int run(const std::string& command, std::string* output) {
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[4096];
+  while (fgets(buffer, sizeof(buffer), pipe)) *output += buffer;
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(HostileStartUp, MapFileNotARegularFileFailsAtOnce) {
+  const std::string pid = std::to_string(getpid());
+  const std::string fifo = "/tmp/wavog_hostile_fifo_" + pid;
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& file : {std::string("/dev/zero"), fifo, std::string("/tmp")}) {
+    SCOPED_TRACE(file);
+    std::string output;
+    const ros::WallTime t0 = ros::WallTime::now();
+    // timeout: a node blocked on the FIFO would exit 124, not 1.
+    const int code = run(std::string("timeout 20 ") + WAVOG_NODE_BIN + " __name:=hostile_" + pid +
+                             " map:=/hostile_" + pid + "/map _map_file:=" + file,
+                         &output);
+    EXPECT_EQ(code, 1) << output;
+    EXPECT_NE(output.find("map_file"), std::string::npos) << output;
+    EXPECT_NE(output.find(file), std::string::npos) << output;
+    EXPECT_NE(output.find("regular file"), std::string::npos) << output;
+    EXPECT_LT((ros::WallTime::now() - t0).toSec(), 15.0);
+  }
+  ::unlink(fifo.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_hostile_input");
+  ros::NodeHandle nh;
+  tf2_ros::StaticTransformBroadcaster static_tf;
+  auto tree = room::staticTree();
+  for (const double x : {kFar, -kFar}) {
+    tf2::Transform t(tf2::Quaternion::getIdentity(), tf2::Vector3(x, 0.0, 0.0));
+    tree.push_back(room::toMsg(t, "base_link", x > 0 ? "far_plus" : "far_minus"));
+  }
+  static_tf.sendTransform(tree);
+  g_scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 50);
+  g_tf_pub = nh.advertise<tf2_msgs::TFMessage>("/tf", 10);
+  auto map_sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map", 2, &g_mutex, &g_map);
+  auto status_sub =
+      room::keepLatest<MapperStatus>(nh, "wavog_mapping/status", 10, &g_mutex, &g_status);
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  room::waitForSubscribers(g_scan_pub, 1, 20.0);
+  return RUN_ALL_TESTS();
+}
