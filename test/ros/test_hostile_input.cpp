@@ -4,7 +4,9 @@
 // scan is 2^31 s back), a /tf transform stamped 2^32 - 1 s (the tf buffer's pruning would throw:
 // refused, counted in tf_refused), lasers placed by tf 2e5 m apart (a read-out of 1.6e13 cells: the layers
 // are refused, not allocated), save_map outside map_dir ('..', absolute, through a symlink), and
-// a map_file that is /dev/zero, a FIFO or a directory (start-up fails at once, naming it).
+// a map_file that is /dev/zero, a FIFO or a directory (start-up fails at once, naming it); beyond
+// the core's limits: beams of 1e7 m and FLT_MAX with range_max inf, a laser 5e10 m away, a scan of
+// 1e6 beams, clear_region of +-1e19 m.
 // No exception may have been needed to survive: ~status.exceptions stays 0.
 #include <gtest/gtest.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -22,6 +24,7 @@
 
 #include "room.h"
 #include "wavog_mapping/MapperStatus.h"
+#include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/SaveMap.h"
 
 namespace {
@@ -37,6 +40,8 @@ ros::Publisher g_tf_pub;  ///< /tf, for a hostile transform
 
 /// base_link -> far_plus / far_minus: lasers 2e5 m either side of the robot.
 constexpr double kFar = 2e5;
+/// base_link -> extent_plus: a laser 5e10 m away, outside the core's representable extent.
+constexpr double kBeyondExtent = 5e10;
 
 MapperStatus::ConstPtr latestStatus() {
   std::lock_guard<std::mutex> lock(g_mutex);
@@ -182,6 +187,68 @@ TEST_F(Hostile, HugeReadOutRefusedNotAllocated) {
   EXPECT_LT(map->info.width, 1000u);
 }
 
+/// Sends `bad`, then a good scan; both must be integrated (no hang) and `beams_no_return` grow.
+void sendNoReturnCase(const std::string& name, const sensor_msgs::LaserScan::Ptr& bad) {
+  SCOPED_TRACE(name);
+  const auto before = latestStatus();
+  ASSERT_TRUE(before);
+  const std::uint64_t integrated = before->inputs[0].integrated + 2;
+  const std::uint64_t no_return = before->inputs[0].beams_no_return;
+  g_scan_pub.publish(bad);
+  ros::WallDuration(0.1).sleep();
+  g_scan_pub.publish(good());
+  const auto after =
+      waitStatus([&](const MapperStatus& s) { return s.inputs[0].integrated >= integrated; });
+  ASSERT_TRUE(after);
+  EXPECT_GE(after->inputs[0].integrated, integrated) << name << " and the good scan after it:\n"
+                                                    << after->inputs[0];
+  EXPECT_GT(after->inputs[0].beams_no_return, no_return) << name << ": a no-return, not a hit";
+  EXPECT_EQ(after->exceptions, 0u);
+}
+
+TEST_F(Hostile, BeyondTheCoreLimitsCountedAndBounded) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  // One beam of 1e7 m, and one of FLT_MAX, with range_max +inf: beyond the hard range limit,
+  // a no-return (once a hang: the block loop covered (2 x reach / block)^2 blocks).
+  for (const float far : {1e7f, std::numeric_limits<float>::max()}) {
+    auto scan = good();
+    scan->range_max = kInf;
+    scan->ranges[scan->ranges.size() / 2] = far;
+    sendNoReturnCase("a beam of " + std::to_string(far) + " m, range_max inf", scan);
+  }
+  // A laser placed by tf 5e10 m away: outside the extent, refused by the core (bad_geometry).
+  auto beyond = good();
+  beyond->header.frame_id = "extent_plus";
+  sendCase("laser at 5e10 m", beyond, &InputStatus::dropped_bad_geometry);
+  // One scan of 1e6 beams in bounded time: the work budget (2^23 beam-cells) limits its range to
+  // 8 cells, so its 3 m beams are no-returns and the scan has nothing to integrate (counted).
+  auto many = good();
+  many->angle_min = -3.1f;
+  many->angle_increment = 6.2f / 1e6f;
+  many->angle_max = many->angle_min + many->angle_increment * (1e6f - 1.0f);
+  many->time_increment = 0.0f;
+  many->ranges.assign(1000000, 3.0f);
+  many->intensities.clear();
+  const std::uint64_t no_return = latestStatus()->inputs[0].beams_no_return;
+  sendCase("a scan of 1e6 beams", many, &InputStatus::dropped_no_valid_beam);
+  EXPECT_GE(latestStatus()->inputs[0].beams_no_return, no_return + 1000000);
+  // clear_region of +-1e19 m clears the whole map (once: an undefined cast, nothing cleared).
+  wavog_mapping::ClearRegion clear;
+  clear.request.min_x = clear.request.min_y = -1e19;
+  clear.request.max_x = clear.request.max_y = 1e19;
+  ASSERT_TRUE(ros::service::call("wavog_mapping/clear_region", clear));
+  EXPECT_TRUE(clear.response.success) << clear.response.message;
+  const ros::Time cleared = ros::Time::now();
+  const auto empty = room::waitLatest(
+      &g_mutex, &g_map,
+      [&](const nav_msgs::OccupancyGrid& g) { return g.header.stamp > cleared; }, 10.0);
+  ASSERT_TRUE(empty);
+  for (const std::int8_t v : empty->data) ASSERT_EQ(v, -1) << "a cell survived clear_region";
+  const auto s = goodScanIntegrated(latestStatus()->inputs[0].integrated);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->exceptions, 0u);
+}
+
 TEST_F(Hostile, SaveMapOnlyBelowMapDir) {
   const std::string pid = std::to_string(getpid());
   const std::string link = "/tmp/wavog_hostile_link_" + pid;
@@ -253,6 +320,9 @@ int main(int argc, char** argv) {
     tf2::Transform t(tf2::Quaternion::getIdentity(), tf2::Vector3(x, 0.0, 0.0));
     tree.push_back(room::toMsg(t, "base_link", x > 0 ? "far_plus" : "far_minus"));
   }
+  tree.push_back(room::toMsg(
+      tf2::Transform(tf2::Quaternion::getIdentity(), tf2::Vector3(kBeyondExtent, 0.0, 0.0)),
+      "base_link", "extent_plus"));
   static_tf.sendTransform(tree);
   g_scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 50);
   g_tf_pub = nh.advertise<tf2_msgs::TFMessage>("/tf", 10);
