@@ -146,36 +146,6 @@ Case decode(const std::uint8_t* data, std::size_t size) {
   return c;
 }
 
-bool sameBits(const Raster& a, const Raster& b) {
-  return a.scale == b.scale && a.box.min_x == b.box.min_x && a.box.min_y == b.box.min_y &&
-         a.box.max_x == b.box.max_x && a.box.max_y == b.box.max_y && a.known == b.known &&
-         a.log_odds.size() == b.log_odds.size() &&
-         std::memcmp(a.log_odds.data(), b.log_odds.data(), a.log_odds.size() * sizeof(float)) == 0;
-}
-
-std::vector<Raster> readOut(const WaveletMap& map) {
-  std::vector<Raster> out;
-  for (int s = 0; s <= map.params().grid.block_levels; ++s) {
-    CellBox box;
-    if (!map.bounds(s, &box)) break;
-    if (!wavog::readoutFits(box)) {
-      wavog_fuzz::expectReadOutRefused(map, s, box);
-      continue;
-    }
-    box = wavog_fuzz::readOutWindow(box);
-    Raster r = map.exportScale(s, box, Aggregation::kMean);
-    const auto cells =
-        static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
-    WAVOG_FUZZ_CHECK(r.log_odds.size() == cells && r.known.size() == cells,
-                     "scale %d: %zu cells for a %lld x %lld window", s, r.log_odds.size(),
-                     static_cast<long long>(box.width()), static_cast<long long>(box.height()));
-    (void)wavog::toOccupancyGrid(r);
-    out.push_back(std::move(r));
-    out.push_back(map.exportScale(s, box, Aggregation::kMax));
-  }
-  return out;
-}
-
 void runOracle(const Case& c, WaveletMap* map) {
   // Everything a scan can reach: poses within 1 m, range limits up to 3 m, half a band of 0.25 m.
   const auto cells = static_cast<std::int64_t>(std::ceil(4.5 / c.params.grid.resolution)) + 2;
@@ -256,7 +226,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     map.clearBox(c.clear.min_x, c.clear.min_y, c.clear.max_x, c.clear.max_y);
   }
 
-  const auto rasters = readOut(map);
+  const auto rasters = wavog_fuzz::readOutEveryScale(map);
   const auto st = map.stats(true);
   WAVOG_FUZZ_CHECK(st.bytes <= st.bytes_reserved, "stats: %zu bytes > %zu reserved", st.bytes,
                    st.bytes_reserved);
@@ -264,11 +234,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   map.save(path);
   WaveletMap loaded(c.params);
   loaded.load(path);
-  const auto again = readOut(loaded);
+  const auto again = wavog_fuzz::readOutEveryScale(loaded);
   WAVOG_FUZZ_CHECK(rasters.size() == again.size(), "round trip: %zu vs %zu rasters", rasters.size(),
                    again.size());
   for (std::size_t i = 0; i < rasters.size(); ++i) {
-    WAVOG_FUZZ_CHECK(sameBits(rasters[i], again[i]), "round trip: raster %zu differs", i);
+    WAVOG_FUZZ_CHECK(wavog_fuzz::sameBits(rasters[i], again[i]), "round trip: raster %zu differs",
+                     i);
   }
   WAVOG_FUZZ_CHECK(loaded.stats(true).observed_cells == st.observed_cells,
                    "round trip: %llu vs %llu observed cells",

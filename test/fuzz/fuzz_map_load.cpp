@@ -55,44 +55,6 @@ MapParams paramsFor(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
   return p;
 }
 
-bool sameBits(const Raster& a, const Raster& b) {
-  return a.scale == b.scale && a.box.min_x == b.box.min_x && a.box.min_y == b.box.min_y &&
-         a.box.max_x == b.box.max_x && a.box.max_y == b.box.max_y && a.known == b.known &&
-         a.log_odds.size() == b.log_odds.size() &&
-         std::memcmp(a.log_odds.data(), b.log_odds.data(), a.log_odds.size() * sizeof(float)) == 0;
-}
-
-// Every scale over the map's bounds, both aggregations; returns the rasters.
-std::vector<Raster> readOut(const WaveletMap& map) {
-  std::vector<Raster> out;
-  for (int s = 0; s <= map.params().grid.block_levels; ++s) {
-    CellBox box;
-    if (!map.bounds(s, &box)) break;
-    if (!wavog::readoutFits(box)) {
-      wavog_fuzz::expectReadOutRefused(map, s, box);
-      continue;
-    }
-    box = wavog_fuzz::readOutWindow(box);
-    for (Aggregation agg : {Aggregation::kMean, Aggregation::kMax}) {
-      Raster r = map.exportScale(s, box, agg);
-      const auto cells =
-          static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
-      WAVOG_FUZZ_CHECK(r.log_odds.size() == cells && r.known.size() == cells,
-                       "scale %d: raster of %zu cells for a %lld x %lld window", s,
-                       r.log_odds.size(), static_cast<long long>(box.width()),
-                       static_cast<long long>(box.height()));
-      const auto grid = wavog::toOccupancyGrid(r);
-      for (std::size_t i = 0; i < grid.size(); ++i) {
-        WAVOG_FUZZ_CHECK(grid[i] >= -1 && grid[i] <= 100, "occupancy %d", grid[i]);
-        WAVOG_FUZZ_CHECK((grid[i] == -1) == (r.known[i] == 0) || std::isnan(r.log_odds[i]),
-                         "known flag and occupancy disagree at %zu", i);
-      }
-      out.push_back(std::move(r));
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -113,7 +75,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     WAVOG_FUZZ_CHECK(map.stats().blocks == 0, "a refused load changed the map");
     return 0;
   }
-  const auto rasters = readOut(map);
+  const auto rasters = wavog_fuzz::readOutEveryScale(map);
   const auto st = map.stats(true);
   WAVOG_FUZZ_CHECK(st.bytes <= st.bytes_reserved, "stats: %zu bytes > %zu reserved", st.bytes,
                    st.bytes_reserved);
@@ -122,11 +84,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   map.save(again_path);
   WaveletMap again(params);
   again.load(again_path);
-  const auto rasters_again = readOut(again);
+  const auto rasters_again = wavog_fuzz::readOutEveryScale(again);
   WAVOG_FUZZ_CHECK(rasters.size() == rasters_again.size(), "round trip: %zu vs %zu rasters",
                    rasters.size(), rasters_again.size());
   for (std::size_t i = 0; i < rasters.size(); ++i) {
-    WAVOG_FUZZ_CHECK(sameBits(rasters[i], rasters_again[i]), "round trip: raster %zu differs", i);
+    WAVOG_FUZZ_CHECK(wavog_fuzz::sameBits(rasters[i], rasters_again[i]),
+                     "round trip: raster %zu differs", i);
   }
   WAVOG_FUZZ_CHECK(again.stats().blocks == st.blocks && again.stats().nodes == st.nodes,
                    "round trip: %zu/%zu blocks, %zu/%zu nodes", again.stats().blocks, st.blocks,

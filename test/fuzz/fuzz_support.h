@@ -9,12 +9,16 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -79,6 +83,46 @@ inline void expectReadOutRefused(const wavog::WaveletMap& map, int scale,
   }
   WAVOG_FUZZ_CHECK(refused, "scale %d: a window of %llu cells was read out", scale,
                    static_cast<unsigned long long>(wavog::readoutCells(window)));
+}
+
+/// Two rasters with the same window, knowledge and bit-identical values.
+inline bool sameBits(const wavog::Raster& a, const wavog::Raster& b) {
+  return a.scale == b.scale && a.box.min_x == b.box.min_x && a.box.min_y == b.box.min_y &&
+         a.box.max_x == b.box.max_x && a.box.max_y == b.box.max_y && a.known == b.known &&
+         a.log_odds.size() == b.log_odds.size() &&
+         std::memcmp(a.log_odds.data(), b.log_odds.data(), a.log_odds.size() * sizeof(float)) == 0;
+}
+
+/// Every scale over the map's bounds, both aggregations (a window the core must refuse is checked
+/// to be refused); each raster's size and its occupancy grid checked. Returns the rasters.
+inline std::vector<wavog::Raster> readOutEveryScale(const wavog::WaveletMap& map) {
+  std::vector<wavog::Raster> out;
+  for (int s = 0; s <= map.params().grid.block_levels; ++s) {
+    wavog::CellBox box;
+    if (!map.bounds(s, &box)) break;
+    if (!wavog::readoutFits(box)) {
+      expectReadOutRefused(map, s, box);
+      continue;
+    }
+    box = readOutWindow(box);
+    for (wavog::Aggregation agg : {wavog::Aggregation::kMean, wavog::Aggregation::kMax}) {
+      wavog::Raster r = map.exportScale(s, box, agg);
+      const auto cells =
+          static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
+      WAVOG_FUZZ_CHECK(r.log_odds.size() == cells && r.known.size() == cells,
+                       "scale %d: raster of %zu cells for a %lld x %lld window", s,
+                       r.log_odds.size(), static_cast<long long>(box.width()),
+                       static_cast<long long>(box.height()));
+      const auto grid = wavog::toOccupancyGrid(r);
+      for (std::size_t i = 0; i < grid.size(); ++i) {
+        WAVOG_FUZZ_CHECK(grid[i] >= -1 && grid[i] <= 100, "occupancy %d", grid[i]);
+        WAVOG_FUZZ_CHECK((grid[i] == -1) == (r.known[i] == 0) || std::isnan(r.log_odds[i]),
+                         "known flag and occupancy disagree at %zu", i);
+      }
+      out.push_back(std::move(r));
+    }
+  }
+  return out;
 }
 
 /// A double a broken driver or an attacker might send: one of the hostile constants (NaN, +-inf,

@@ -12,6 +12,9 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
+
+#include <gtest/gtest.h>
 
 #include "wavog_mapping/io/carmen_reader.h"
 
@@ -21,6 +24,20 @@ namespace wavog_tool_test {
 struct RunResult {
   int status = -1;
   std::string err;
+};
+
+/// Removes a scratch directory once every test of the program has run:
+/// `::testing::AddGlobalTestEnvironment(new RemoveAtEnd(workDir()))`.
+class RemoveAtEnd : public ::testing::Environment {
+ public:
+  explicit RemoveAtEnd(std::filesystem::path dir) : dir_(std::move(dir)) {}
+  void TearDown() override {
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+  }
+
+ private:
+  std::filesystem::path dir_;
 };
 
 /// A new, empty directory <tmp>/<name>_<pid> (emptied if it exists).

@@ -268,13 +268,7 @@ TEST(Log2Bag, MissingInputAndBadUsage) {
   EXPECT_NE(r.err.find("Usage: wavog_log2bag"), std::string::npos);
 }
 
-class Cleanup : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(workDir(), ec);
-  }
-};
-const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new Cleanup);
+const auto* const kCleanup =
+    ::testing::AddGlobalTestEnvironment(new wavog_tool_test::RemoveAtEnd(workDir()));
 
 }  // namespace

@@ -394,13 +394,7 @@ TEST(Offline, ClearErrors) {
   EXPECT_NE(r.err.find("Usage: wavog_offline"), std::string::npos) << r.err;
 }
 
-class Cleanup : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(workDir(), ec);
-  }
-};
-const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new Cleanup);
+const auto* const kCleanup =
+    ::testing::AddGlobalTestEnvironment(new wavog_tool_test::RemoveAtEnd(workDir()));
 
 }  // namespace
