@@ -201,8 +201,12 @@ void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& 
   ++c[Counter::kIntegrated];
   changed_since_publish_ = true;
   c.last_stamp = scan.header.stamp;
-  const double reach = wavog::scanReach(view, map_.params().sensor, map_.resolution());
-  publisher_->touched({pose.x - reach, pose.y - reach, pose.x + reach, pose.y + reach});
+  // Every cell the scan changed lies in the core's touched box (finest cells, in metres here).
+  const double res = map_.resolution();
+  publisher_->touched({static_cast<double>(st.touched.min_x) * res,
+                       static_cast<double>(st.touched.min_y) * res,
+                       static_cast<double>(st.touched.max_x) * res,
+                       static_cast<double>(st.touched.max_y) * res});
 }
 
 void MappingRos::Impl::dropLocked(Input* in, DropReason reason, const std::string& detail) {
