@@ -3,8 +3,10 @@
 # core-only clang tree. A crash leaves its input in build-fuzz/artifacts/<harness>/.
 BUILD_FUZZ ?= $(ROOT)/build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_CXX ?= $(shell command -v clang++-14 || command -v clang++)
-FUZZ_CC ?= $(shell command -v clang-14 || command -v clang)
+# The compilers are looked up when the recipe runs: on a fresh machine, install_deps.sh fuzz
+# installs clang first.
+FUZZ_CXX ?= $$(command -v clang++-14 || command -v clang++)
+FUZZ_CC ?= $$(command -v clang-14 || command -v clang)
 
 .PHONY: fuzz
 ## libFuzzer harnesses (map loader, CARMEN reader, scan integration, node message path), FUZZ_SECONDS each.
