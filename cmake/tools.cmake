@@ -15,7 +15,7 @@ target_compile_options(wavog_log2bag PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_log2bag PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
 
 if(TARGET wavog_ros AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/tools/offline.cpp)
-  add_executable(wavog_offline src/tools/offline.cpp)
+  add_executable(wavog_offline src/tools/offline.cpp src/tools/offline_inputs.cpp)
   target_include_directories(wavog_offline SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(wavog_offline PRIVATE wavog_tool_support wavog_ros ${catkin_LIBRARIES})
   target_compile_options(wavog_offline PRIVATE ${WAVOG_WARNINGS})
