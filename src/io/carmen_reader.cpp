@@ -1,8 +1,12 @@
-// CARMEN log reader. Lines are read through zlib's gz* interface, which reads plain files as they
-// are; gzip is detected from the magic bytes so that a truncated stream can be told apart from the
-// end of a plain file. Numbers are parsed with std::from_chars (locale-independent).
+// CARMEN log reader. Lines are read through zlib's gz* interface from one descriptor (a file, a
+// FIFO or a pipe); zlib reads plain text as it is and says whether the stream was gzip, so that a
+// truncated stream can be told apart from the end of a plain file. Numbers are parsed with
+// std::from_chars (locale-independent).
 #include "wavog_mapping/io/carmen_reader.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -248,20 +252,25 @@ struct CarmenReader::Impl {
 CarmenReader::CarmenReader(const std::string& path, bool strict) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   impl_->strict = strict;
-  if (isDirectory(path)) throw std::runtime_error(path + ": is a directory, not a CARMEN log");
-  std::FILE* probe = std::fopen(path.c_str(), "rb");
-  if (probe == nullptr) {
-    throw std::runtime_error(path + ": cannot open: " + std::strerror(errno));
+  // One open, so that a pipe or FIFO (`<(zcat log)`) loses no byte to a probe; zlib reads plain
+  // text transparently and tells afterwards whether the stream was gzip.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(path + ": cannot open: " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !(S_ISREG(st.st_mode) || S_ISFIFO(st.st_mode))) {
+    const bool dir = S_ISDIR(st.st_mode);
+    ::close(fd);
+    throw std::runtime_error(path + (dir ? ": is a directory, not a CARMEN log"
+                                         : ": not a regular file, FIFO or pipe (a device or "
+                                           "socket), not a CARMEN log"));
   }
-  unsigned char magic[2] = {0, 0};
-  const std::size_t got = std::fread(magic, 1, 2, probe);
-  std::fclose(probe);
-  impl_->gzip = (got == 2 && magic[0] == 0x1f && magic[1] == 0x8b);
-  impl_->file = gzopen(path.c_str(), "rb");
+  impl_->file = gzdopen(fd, "rb");
   if (impl_->file == nullptr) {
-    throw std::runtime_error(path + ": cannot open: " + std::strerror(errno));
+    ::close(fd);
+    throw std::runtime_error(path + ": cannot open: out of memory");
   }
   gzbuffer(impl_->file, kGzBufferBytes);
+  impl_->gzip = gzdirect(impl_->file) == 0;
 }
 
 CarmenReader::~CarmenReader() {

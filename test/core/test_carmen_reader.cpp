@@ -2,6 +2,7 @@
 // logs for every line type, malformed lines (strict and lenient), truncated and corrupted gzip,
 // missing files and the data directory search. Uses gtest and wavog_io only.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -14,6 +15,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "wavog_mapping/io/carmen_reader.h"
@@ -263,6 +265,59 @@ TEST(CarmenReader, ReadsGzipDetectedByMagicWhateverTheName) {
   ASSERT_TRUE(reader.next(&s));
   EXPECT_EQ(s.type, "ROBOTLASER1");
   EXPECT_FALSE(reader.next(&s));
+}
+
+// Streams `content` into a new FIFO at `path` from a thread (the writer blocks until the reader
+// opens it).
+class FifoWriter {
+ public:
+  FifoWriter(const std::string& path, std::string content) {
+    if (::mkfifo(path.c_str(), 0600) != 0) throw std::runtime_error("mkfifo " + path);
+    writer_ = std::thread([path, content = std::move(content)] {
+      std::ofstream out(path, std::ios::binary);
+      out << content;
+    });
+  }
+  ~FifoWriter() { writer_.join(); }
+
+ private:
+  std::thread writer_;
+};
+
+TEST(CarmenReader, ReadsPlainAndGzipLogsFromAFifoWithoutLosingBytes) {
+  TempDir tmp;
+  // The first bytes are those a magic-number probe would have taken from the stream.
+  const std::string log = flaser(181, "2.5", 10.0) + "\n" + robotLaser(11.0) + "\n" +
+                          flaser(90, "1.5", 12.0) + "\n";
+  for (const bool gz : {false, true}) {
+    SCOPED_TRACE(gz ? "gzip" : "plain");
+    const std::string path = tmp.path(gz ? "fifo_gz" : "fifo_plain");
+    FifoWriter writer(path, gz ? gzipStored(log) : log);
+    wavog::CarmenReader reader(path);
+    EXPECT_EQ(reader.compressed(), gz);
+    wavog::CarmenScan s;
+    ASSERT_TRUE(reader.next(&s));
+    EXPECT_EQ(s.type, "FLASER");
+    EXPECT_EQ(s.ranges.size(), 181u);
+    EXPECT_DOUBLE_EQ(s.ipc_timestamp, 10.0);
+    ASSERT_TRUE(reader.next(&s));
+    EXPECT_EQ(s.type, "ROBOTLASER1");
+    ASSERT_TRUE(reader.next(&s));
+    EXPECT_EQ(s.ranges.size(), 90u);
+    EXPECT_FALSE(reader.next(&s));
+  }
+}
+
+TEST(CarmenReader, RefusesDevicesAtOnce) {
+  for (const char* device : {"/dev/zero", "/dev/null"}) {
+    try {
+      wavog::CarmenReader reader(device);
+      FAIL() << device << ": no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("not a regular file, FIFO or pipe"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 TEST(CarmenReader, MalformedLinesNameFileAndLine) {
