@@ -91,15 +91,21 @@ template <PolicyType P>
 }
 
 template <PolicyType P>
-std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, IntegrateStats* st) {
+std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, double period,
+                           IntegrateStats* st) {
   const MapParams& p = impl.params;
+  // Forgetting: gamma per scan, or from the scan's period with forget_half_life.
+  const unsigned units = impl.scanUnits(period);
+  const double a = impl.half_life ? impl.multiplier(units) : impl.a;
+  const double g = impl.half_life ? 1.0 - a : p.policy.gamma;
   const detail::PolicyConsts pc{p.sensor.odd_occ,
                                 p.sensor.odd_emp,
-                                impl.a,
-                                P == PolicyType::kForget ? p.policy.gamma : 0.0,
+                                a,
+                                P == PolicyType::kForget ? g : 0.0,
                                 p.policy.clamp_min,
                                 p.policy.clamp_max,
-                                std::max(p.skip_tolerance, kUnchangedFloor)};
+                                std::max(p.skip_tolerance, kUnchangedFloor),
+                                units};
   const detail::PreparedScan& ps = cls.scan();
   const int L = impl.levels;
   const double block_size = static_cast<double>(std::int64_t{1} << L) * ps.res;
@@ -159,7 +165,8 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, In
 }
 
 // One instantiation per policy, in the order of PolicyType's enumerators.
-using IntegrateFn = std::uint64_t (*)(WaveletMap::Impl&, const ScanClassifier&, IntegrateStats*);
+using IntegrateFn = std::uint64_t (*)(WaveletMap::Impl&, const ScanClassifier&, double,
+                                      IntegrateStats*);
 constexpr IntegrateFn kIntegrateFor[] = {
     &integrateAll<PolicyType::kNone>,       &integrateAll<PolicyType::kMax>,
     &integrateAll<PolicyType::kClamp>,      &integrateAll<PolicyType::kForget>,
@@ -184,7 +191,7 @@ IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& s
   const detail::PreparedScan& ps = classifier.scan();
   st.touched = reachBox(ps.px, ps.py, ps.reach, ps.res);
   const auto policy = static_cast<std::size_t>(impl_->params.policy.type);
-  st.nodes_visited = kIntegrateFor[policy](*impl_, classifier, &st);
+  st.nodes_visited = kIntegrateFor[policy](*impl_, classifier, scan.period, &st);
   classifier.releaseIfLarge();
   impl_->nodes_visited_last = st.nodes_visited;
   return st;

@@ -18,9 +18,9 @@
 namespace wavog {
 namespace detail {
 
-/// Sets or clears `bit` in a knowledge mask.
-inline void setBit(std::uint8_t* mask, std::uint8_t bit, bool on) {
-  *mask = static_cast<std::uint8_t>(on ? (*mask | bit) : (*mask & ~bit));
+/// A 4-bit knowledge mask with `bit` set or cleared.
+inline std::uint8_t withBit(unsigned mask, unsigned bit, bool on) {
+  return static_cast<std::uint8_t>((on ? (mask | bit) : (mask & ~bit)) & 0xFu);
 }
 
 }  // namespace detail
@@ -34,8 +34,22 @@ struct WaveletMap::Impl {
   double init = 0.0;              ///< prior log-odds of never-observed cells
   double a = 1.0;                 ///< 1 - gamma for "forget", else 1
   double prune_threshold = 1e-6;  ///< effective tau
-  int k_star = 256;  ///< pending count at which a fully-E subtree is negligible (<= 255)
-  std::array<double, 256> pow_a{};  ///< a^k
+  /// Pending forgetting (Node::k, ALGORITHM.md 6.3) counts units: one scan's a (a^k, k <= 255)
+  /// without forget_half_life, else 2^-unit_log2 halvings each (2^(-k unit), k < 2^16), so that
+  /// scans of different periods add their exponents exactly.
+  bool half_life = false;
+  double unit_log2 = 0.0;  ///< forget_half_life: halvings per unit
+  unsigned k_cap = 255;    ///< largest pending count a node holds (it is flushed beyond)
+  int k_star = 256;        ///< pending count at which a fully-E subtree is negligible (<= k_cap)
+  std::array<double, 256> mult_lo{};  ///< multiplier(k) for k < 256 (a^k: repeated products)
+  std::array<double, 256> mult_hi{};  ///< multiplier(256 j)
+
+  /// The true value of details stored under k pending units.
+  double multiplier(unsigned k) const { return mult_hi[k >> 8] * mult_lo[k & 255u]; }
+  /// Pending units of one scan of `period` s ("forget"; 1 without forget_half_life).
+  unsigned scanUnits(double period) const;
+  /// The factor a pending count of k stands for, as saved (multiplier(k) = unitFactor()^k).
+  double unitFactor() const { return half_life ? std::exp2(-unit_log2) : a; }
 
   detail::NodePool pool;
   detail::BlockMap blocks;
@@ -44,7 +58,8 @@ struct WaveletMap::Impl {
   std::size_t nodes = 0;  ///< live nodes (roots included)
   std::uint64_t nodes_visited_last = 0;
 
-  /// Recomputes a, pow_a, k_star, init from params (policy changes).
+  /// Recomputes a, the pending units and their multipliers, k_star, init from params (policy
+  /// changes).
   void configure();
 
   detail::Node& child(detail::Node& n, int q) { return pool.group(n.children).n[q]; }
@@ -126,7 +141,7 @@ inline detail::Node& WaveletMap::Impl::installChild(detail::NodeStore& store, de
 
 inline void WaveletMap::Impl::flush(detail::Node& n) {
   if (n.k == 0) return;
-  const float m = static_cast<float>(pow_a[n.k]);
+  const float m = static_cast<float>(multiplier(n.k));
   for (float& d : n.d) d *= m;
   if (n.children != 0) {
     for (int q = 0; q < 4; ++q) {
@@ -137,8 +152,8 @@ inline void WaveletMap::Impl::flush(detail::Node& n) {
 }
 
 inline void WaveletMap::Impl::addPending(detail::Node& n, unsigned m) {
-  if (n.k + m > 255u) flush(n);
-  n.k = static_cast<std::uint8_t>(n.k + m);
+  if (n.k + m > k_cap) flush(n);
+  n.k = static_cast<std::uint16_t>(n.k + m);
 }
 
 }  // namespace wavog

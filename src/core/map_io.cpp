@@ -1,12 +1,13 @@
-// Native map files. Layout (little-endian, version 1):
-//   "WAVOGMAP" | u32 version | f64 resolution | i32 block_levels | f64 prior | f64 a (= 1 - gamma
-//   of the pending forgetting tags) | u64 block count
+// Native map files. Layout (little-endian, version 2):
+//   "WAVOGMAP" | u32 version | f64 resolution | i32 block_levels | f64 prior | f64 a (the factor
+//   one pending unit stands for: 1 - gamma, or 2^-unit with forget_half_life) | u64 block count
 //   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
-//              [root subtree, pre-order: f32 dx dy dxy (stored) | u8 pending count k |
+//              [root subtree, pre-order: f32 dx dy dxy (stored) | u16 pending count k |
 //               u8 child_mask | u8 known_all | u8 known_any | children in q order]
 //   u32 CRC-32 (IEEE) of every byte before it.
+// Version 1 (before forget_half_life) is the same with a u8 pending count; it still loads.
 // Stored details and lazy counts are written as they are, so a round trip is bit-exact; a map
-// loaded under another gamma applies the file's pending tags while loading.
+// loaded under another factor applies the file's pending tags while loading.
 // Files are written and read through map_file.h (exclusive temporary + rename, regular files only).
 #include <algorithm>
 #include <array>
@@ -29,12 +30,14 @@ using detail::Block;
 using detail::Node;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kOldestVersion = 1;  // u8 pending counts
 // Fixed header: magic, version, resolution, block_levels, prior, forgetting factor, block count.
 constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
 constexpr std::size_t kCrcBytes = 4;
 constexpr std::size_t kMinBlockBytes = 4 + 4 + 8 + 1;  // bx, by, average, flags
-constexpr std::size_t kNodeBytes = 3 * 4 + 4;          // three details, k, mask, known bits
+// Three details, k, mask, known bits.
+std::size_t nodeBytes(std::uint32_t version) { return 3 * 4 + (version == 1 ? 1 : 2) + 3; }
 
 std::uint32_t crc32(const unsigned char* data, std::size_t size) {
   static const std::array<std::uint32_t, 256> table = [] {
@@ -90,40 +93,53 @@ void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
   for (float d : n.d) w->put(d);
   w->put(n.k);
   w->put(n.child_mask);
-  w->put(n.known_all);
-  w->put(n.known_any);
+  w->put(static_cast<std::uint8_t>(n.known_all));
+  w->put(static_cast<std::uint8_t>(n.known_any));
   if (l <= 1) return;
   for (int q = 0; q < 4; ++q) {
     if (impl.hasChild(n, q)) writeNode(impl, impl.child(n, q), l - 1, w);
   }
 }
 
+// How a file's pending counts are read: their width and the factor one unit stands for.
+struct PendingFormat {
+  std::uint32_t version;
+  double file_a;
+  bool same_unit;  // file_a is the map's unit factor: counts are kept as they are
+};
+
 // Reads a subtree into `impl` (a fresh map). Throws std::runtime_error on inconsistent data.
-// `file_a`: the file's forgetting factor; when it differs from the map's, pending counts are
-// applied with it now (`pending` accumulates the ancestors' counts).
-void readNode(WaveletMap::Impl& impl, Node& n, int l, double file_a, int pending, Reader* r) {
+// A node's pending count is kept when it means the same for the map (and fits its counts);
+// otherwise it is applied now with the file's factor, together with `pending`, the ancestors'
+// counts applied the same way.
+void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, std::int64_t pending,
+              Reader* r) {
   for (float& d : n.d) {
     d = r->get<float>();
     if (!std::isfinite(d)) throw std::runtime_error("non-finite detail");
   }
-  n.k = r->get<std::uint8_t>();
-  pending += n.k;
-  if (file_a != impl.a) {
-    const auto m = static_cast<float>(std::pow(file_a, pending));
+  const unsigned k = f.version == 1 ? r->get<std::uint8_t>() : r->get<std::uint16_t>();
+  if (f.same_unit && pending == 0 && k <= impl.k_cap) {
+    n.k = static_cast<std::uint16_t>(k);
+  } else {
+    pending += k;
+    const auto m = static_cast<float>(std::pow(f.file_a, static_cast<double>(pending)));
     for (float& d : n.d) d *= m;
     n.k = 0;
   }
   const auto mask = r->get<std::uint8_t>();
-  n.known_all = r->get<std::uint8_t>();
-  n.known_any = r->get<std::uint8_t>();
-  if (mask > 0xF || n.known_all > 0xF || n.known_any > 0xF || (n.known_all & ~n.known_any) != 0) {
+  const auto known_all = r->get<std::uint8_t>();
+  const auto known_any = r->get<std::uint8_t>();
+  if (mask > 0xF || known_all > 0xF || known_any > 0xF || (known_all & ~known_any) != 0) {
     throw std::runtime_error("bad node flags");
   }
+  n.known_all = known_all & 0xFu;
+  n.known_any = known_any & 0xFu;
   if (l == 1 && mask != 0) throw std::runtime_error("children below level 1");
   for (int q = 0; q < 4; ++q) {
     if (!((mask >> q) & 1u)) continue;
     Node& c = impl.installChild(n, q, Node{});
-    readNode(impl, c, l - 1, file_a, file_a != impl.a ? pending : 0, r);
+    readNode(impl, c, l - 1, f, pending, r);
   }
 }
 
@@ -143,9 +159,9 @@ std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
   }
   std::uint32_t version;
   std::memcpy(&version, head.data() + sizeof(kMagic), sizeof(version));
-  if (version != kVersion) {
-    throw fail("format version " + std::to_string(version) + ", this build reads version " +
-               std::to_string(kVersion));
+  if (version < kOldestVersion || version > kVersion) {
+    throw fail("format version " + std::to_string(version) + ", this build reads versions " +
+               std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
   }
   if (size < kHeaderBytes + kCrcBytes) throw fail("truncated (" + std::to_string(size) + " bytes)");
   std::uint64_t count;
@@ -154,7 +170,8 @@ std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
   const double nodes_per_block = (std::ldexp(1.0, 2 * levels) - 1.0) / 3.0;
   const double largest = static_cast<double>(kHeaderBytes + kCrcBytes) +
                          static_cast<double>(count) *
-                             (static_cast<double>(kMinBlockBytes) + nodes_per_block * kNodeBytes);
+                             (static_cast<double>(kMinBlockBytes) +
+                              nodes_per_block * static_cast<double>(nodeBytes(version)));
   if (static_cast<double>(size) > largest) {
     throw fail(std::to_string(size) + " bytes, more than its " + std::to_string(count) +
                " blocks can fill (at most " + std::to_string(static_cast<std::uint64_t>(largest)) +
@@ -174,7 +191,7 @@ void WaveletMap::save(const std::string& path) const {
   w.put(impl.params.grid.resolution);
   w.put(static_cast<std::int32_t>(impl.levels));
   w.put(impl.init);
-  w.put(impl.a);
+  w.put(impl.unitFactor());
   w.put(static_cast<std::uint64_t>(impl.blocks.size()));
   for (const auto& kv : impl.blocks) {
     const Block& b = kv.second;
@@ -206,12 +223,15 @@ void WaveletMap::load(const std::string& path) {
 
   Impl fresh(impl_->params);
   try {
+    std::uint32_t version;
+    std::memcpy(&version, data.data() + sizeof(kMagic), sizeof(version));
     Reader r(data.data() + sizeof(kMagic) + 4, body - sizeof(kMagic) - 4);
     const auto res = r.get<double>();
     const auto levels = r.get<std::int32_t>();
     (void)r.get<double>();  // prior at save time: informative only
     const auto file_a = r.get<double>();
     if (!(file_a >= 0.0 && file_a <= 1.0)) throw std::runtime_error("bad forgetting factor");
+    const PendingFormat format{version, file_a, file_a == fresh.unitFactor()};
     if (res != impl_->params.grid.resolution || levels != impl_->levels) {
       std::ostringstream s;
       s << "its resolution " << res << " m / block_levels " << levels << " differ from this map's "
@@ -242,7 +262,7 @@ void WaveletMap::load(const std::string& path) {
       b.has_root = (flags & 4) != 0;
       if (b.has_root) {
         ++fresh.nodes;
-        readNode(fresh, b.root, fresh.levels, file_a, 0, &r);
+        readNode(fresh, b.root, fresh.levels, format, 0, &r);
       }
     }
     if (!r.done()) throw std::runtime_error("trailing bytes");

@@ -54,8 +54,8 @@ class ChildSlot {
   bool knownAll() const { return (parent_.known_all & bit_) != 0; }
   bool knownAny() const { return (parent_.known_any & bit_) != 0; }
   void setKnown(bool all, bool any) {
-    setBit(&parent_.known_all, bit_, all);
-    setBit(&parent_.known_any, bit_, any);
+    parent_.known_all = withBit(parent_.known_all, bit_, all) & 0xFu;  // 4-bit masks
+    parent_.known_any = withBit(parent_.known_any, bit_, any) & 0xFu;
   }
   void install(const Node& m) { impl_.installChild(store_, parent_, q_, m); }
   void remove() { impl_.removeChild(store_, parent_, q_); }

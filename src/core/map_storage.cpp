@@ -23,24 +23,56 @@ WaveletMap::Impl::Impl(const MapParams& p) : params(p) {
 
 void WaveletMap::Impl::configure() {
   init = params.initValue();
-  a = params.policy.type == PolicyType::kForget ? 1.0 - params.policy.gamma : 1.0;
-  pow_a[0] = 1.0;
-  for (std::size_t k = 1; k < pow_a.size(); ++k) pow_a[k] = pow_a[k - 1] * a;
+  const bool forget = params.policy.type == PolicyType::kForget;
+  a = forget ? 1.0 - params.policy.gamma : 1.0;
   // tau = 0 still drops details below float round-off of the log-odds scale.
   constexpr double kRoundOff = 1e-6;
   prune_threshold = std::max(params.prune_threshold, kRoundOff);
-  // Section 6.5: all values stay in [odd_emp, odd_occ], so |d| <= 2R; after K* pending steps
-  // every detail of the subtree is below the pruning threshold and the subtree can go.
+  // Section 6.5: all values stay in [odd_emp, odd_occ], so |d| <= 2R; once the pending
+  // multiplier is below tau / 2R every detail of the subtree is below the pruning threshold and
+  // the subtree can go.
+  const double halvings = std::log2(2.0 * (params.sensor.odd_occ - params.sensor.odd_emp) /
+                                    prune_threshold);
+  half_life = forget && params.policy.forget_half_life > 0.0;
+  if (half_life) {
+    // The finest unit 2^-e for which the negligible multiplier still fits a 16-bit count.
+    constexpr double kMaxCount = 65535.0;
+    const int e = std::min(16, static_cast<int>(std::floor(std::log2(kMaxCount / halvings))));
+    unit_log2 = std::ldexp(1.0, -e);
+    k_cap = 65535;
+    k_star = static_cast<int>(std::ceil(halvings / unit_log2));
+    for (std::size_t j = 0; j < mult_lo.size(); ++j) {
+      mult_lo[j] = std::exp2(-static_cast<double>(j) * unit_log2);
+      mult_hi[j] = std::exp2(-static_cast<double>(256 * j) * unit_log2);
+    }
+    return;
+  }
+  unit_log2 = 0.0;
+  k_cap = 255;
+  mult_lo[0] = 1.0;
+  for (std::size_t k = 1; k < mult_lo.size(); ++k) mult_lo[k] = mult_lo[k - 1] * a;
+  mult_hi.fill(0.0);
+  mult_hi[0] = 1.0;  // counts stay <= 255: multiplier(k) is a^k as a product of k factors
   k_star = 256;
-  if (params.policy.type == PolicyType::kForget) {
-    const double r = params.sensor.odd_occ - params.sensor.odd_emp;
+  if (forget) {
     if (a <= 0.0) {
       k_star = 1;
     } else if (a < 1.0) {
+      const double r = params.sensor.odd_occ - params.sensor.odd_emp;
       const double k = std::ceil(std::log(prune_threshold / (2.0 * r)) / std::log(a));
       if (k < 255.0) k_star = std::max(1, static_cast<int>(k));
     }
   }
+}
+
+unsigned WaveletMap::Impl::scanUnits(double period) const {
+  if (!half_life) return 1;
+  const double exponent = std::isfinite(period) && period > 0.0
+                              ? period / params.policy.forget_half_life
+                              : -std::log2(1.0 - params.policy.gamma);  // +inf for gamma 1
+  const double units = std::round(exponent / unit_log2);
+  return units >= static_cast<double>(k_star) ? static_cast<unsigned>(k_star)
+                                              : static_cast<unsigned>(units);
 }
 
 void WaveletMap::Impl::freeSubtree(detail::NodeStore& store, Node& n) {

@@ -80,7 +80,7 @@ class Integrator {
       scaleSubtree(*node);
       return;
     }
-    impl_.addPending(*node, 1);
+    impl_.addPending(*node, pc_.units);
     if (node->k >= impl_.k_star) slot.remove();  // section 6.5: subtree negligible
   }
 
@@ -138,8 +138,8 @@ class Integrator {
       }
     }
     const auto known = static_cast<std::uint8_t>(cells.e | cells.o);
-    n.known_all = static_cast<std::uint8_t>(n.known_all | known);
-    n.known_any = static_cast<std::uint8_t>(n.known_any | known);
+    n.known_all = (n.known_all | known) & 0xFu;  // 4-bit masks
+    n.known_any = (n.known_any | known) & 0xFu;
     return foldChanges(n, delta);
   }
 

@@ -42,7 +42,7 @@ class RasterWriter {
       fill(rx0, ry0, span, v, any);
       return;
     }
-    const double m = mult * impl_.pow_a[n->k];
+    const double m = mult * impl_.multiplier(n->k);
     const double d[3] = {n->d[0] * m, n->d[1] * m, n->d[2] * m};
     const auto c = haar::backward(avg, d);
     const std::int64_t half = std::int64_t{1} << (l - 1);
@@ -57,7 +57,7 @@ class RasterWriter {
  private:
   // Max over the observed finest cells below node n (level l, average avg).
   float maxObserved(const Node& n, int l, double avg, double mult) const {
-    const double m = mult * impl_.pow_a[n.k];
+    const double m = mult * impl_.multiplier(n.k);
     const double d[3] = {n.d[0] * m, n.d[1] * m, n.d[2] * m};
     const auto c = haar::backward(avg, d);
     float best = kNoObservedCell;

@@ -12,10 +12,12 @@
 namespace wavog {
 namespace detail {
 
-/// Policy constants for one scan: odd values, forgetting a = 1 - g and g, clamp bounds, and the
-/// tolerance below which an E update counts as changing nothing (ALGORITHM.md section 3.4).
+/// Policy constants for one scan: odd values, forgetting a = 1 - g and g, clamp bounds, the
+/// tolerance below which an E update counts as changing nothing (ALGORITHM.md section 3.4), and
+/// the pending units standing for a in a lazy tag (WaveletMap::Impl::multiplier(units) == a).
 struct PolicyConsts {
   double odd_occ, odd_emp, a, g, lo, hi, unchanged_tol;
+  unsigned units;
 };
 
 /// The value of a cell at log-odds x after an E (cls kEmpty) or O observation.

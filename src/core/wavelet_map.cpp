@@ -22,6 +22,15 @@ WaveletMap& WaveletMap::operator=(WaveletMap&&) noexcept = default;
 const MapParams& WaveletMap::params() const { return impl_->params; }
 double WaveletMap::resolution() const { return impl_->params.grid.resolution; }
 
+double WaveletMap::forgetRate(double period) const {
+  const Impl& impl = *impl_;
+  if (impl.params.policy.type != PolicyType::kForget) return 0.0;
+  if (!impl.half_life) return impl.params.policy.gamma;
+  return 1.0 - impl.multiplier(impl.scanUnits(period));
+}
+
+double WaveletMap::forgetUnit() const { return impl_->unit_log2; }
+
 CellIndex WaveletMap::cellAt(double x, double y) const {
   const double r = impl_->params.grid.resolution;
   return {clampedCellIndex(std::floor(x / r)), clampedCellIndex(std::floor(y / r))};
@@ -42,7 +51,7 @@ std::pair<float, bool> lookup(const WaveletMap::Impl& impl, const CellIndex& cel
   const Node* n = &b->root;
   double mult = 1.0;
   for (int l = levels; l >= 1; --l) {
-    mult *= impl.pow_a[n->k];
+    mult *= impl.multiplier(n->k);
     const int q = static_cast<int>(((cell.x >> (l - 1)) & 1) | (((cell.y >> (l - 1)) & 1) << 1));
     const double d[3] = {n->d[0] * mult, n->d[1] * mult, n->d[2] * mult};
     s = haar::backwardChild(s, d, q);

@@ -43,6 +43,9 @@ class DenseReference {
   DenseReference(const std::vector<wavog::MapParams>& layers, const wavog::CellBox& extent);
 
   void integrate(const wavog::Pose2& pose, const wavog::ScanView& scan);
+  /// Sets the forgetting rate of layer `layer` for the following scans (a per-scan gamma, as
+  /// forget_half_life makes them).
+  void setGamma(std::size_t layer, double gamma) { layers_.at(layer).policy.gamma = gamma; }
 
   /// Selects the layer that value(), known() and the block functions read (default 0).
   void selectLayer(std::size_t layer) { layer_ = layer; }

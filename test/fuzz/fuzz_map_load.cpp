@@ -4,7 +4,8 @@
 // (resolution onwards), framed with the magic, version and a valid CRC-32, so that mutations
 // reach the parser behind the checksum; clear: the rest is the file as it is. Bits 1-2: the
 // loading map's policy (clamp, or forgetting with one of three gammas, so a file's pending
-// forgetting tags are sometimes applied while loading).
+// forgetting tags are sometimes applied while loading). Bit 3: the framed version is 1 (u8
+// pending counts) instead of 2. Bit 4: forgetting with forget_half_life (16-bit pending units).
 #include <zlib.h>
 
 #include <cmath>
@@ -23,12 +24,11 @@ using wavog::Raster;
 using wavog::WaveletMap;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
-constexpr std::uint32_t kVersion = 1;
 
-std::vector<std::uint8_t> frame(const std::uint8_t* body, std::size_t size) {
+std::vector<std::uint8_t> frame(const std::uint8_t* body, std::size_t size, std::uint32_t version) {
   std::vector<std::uint8_t> out(kMagic, kMagic + sizeof(kMagic));
-  const auto* v = reinterpret_cast<const std::uint8_t*>(&kVersion);
-  out.insert(out.end(), v, v + sizeof(kVersion));
+  const auto* v = reinterpret_cast<const std::uint8_t*>(&version);
+  out.insert(out.end(), v, v + sizeof(version));
   out.insert(out.end(), body, body + size);
   const auto crc = static_cast<std::uint32_t>(crc32(0L, out.data(), static_cast<uInt>(out.size())));
   const auto* c = reinterpret_cast<const std::uint8_t*>(&crc);
@@ -44,6 +44,7 @@ MapParams paramsFor(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
       MapParams::defaultsFor(policy == 0 ? wavog::PolicyType::kClamp : wavog::PolicyType::kForget);
   static const double kGamma[] = {0.3, 0.3, 0.5, 1.0};
   p.policy.gamma = kGamma[policy];
+  if (policy != 0 && (mode & 16)) p.policy.forget_half_life = 0.3;
   if (file.size() >= 24) {
     MapParams q = p;
     std::memcpy(&q.grid.resolution, file.data() + 12, sizeof(double));
@@ -61,7 +62,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t mode = data[0];
   const std::vector<std::uint8_t> file =
-      (mode & 1) ? frame(data + 1, size - 1) : std::vector<std::uint8_t>(data + 1, data + size);
+      (mode & 1) ? frame(data + 1, size - 1, (mode & 8) ? 1 : 2)
+                 : std::vector<std::uint8_t>(data + 1, data + size);
   const MapParams params = paramsFor(file, mode);
   static const std::string path = wavog_fuzz::scratchPath("load.wavog");
   static const std::string again_path = wavog_fuzz::scratchPath("again.wavog");

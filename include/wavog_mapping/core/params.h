@@ -67,7 +67,15 @@ struct PolicyParams {
   /// The policy applied to E and O cells; U cells are never touched.
   PolicyType type = PolicyType::kForget;
   /// Forgetting rate gamma of eq. 1.6, in (0, 1]; used by "forget" only (paper: 0.3 at 10 Hz).
+  /// With forget_half_life, only for scans whose period is unknown.
   double gamma = 0.3;
+  /// "forget" only: half-life (s) of what a cell remembers while it is observed, 0 = off (each
+  /// scan forgets by gamma, whatever its rate), else in [0.001, 1e6]. A scan of period dt
+  /// (ScanView::period) then forgets by g = 1 - 2^(-dt / forget_half_life), so that lasers of any
+  /// rate forget at the same rate per second. The exponent dt / forget_half_life of each scan is
+  /// rounded to a multiple of the map's forgetting unit (WaveletMap::forgetUnit(), 2^-11 with
+  /// the default pruning), and capped where a subtree becomes negligible.
+  double forget_half_life = 0.0;
   /// Lower clamp bound (log-odds), < 0; used by "clamp" and "clamp_lower".
   double clamp_min = -2.0;
   /// Upper clamp bound (log-odds), > 0; used by "clamp" and "clamp_upper".

@@ -38,6 +38,9 @@ struct ScanView {
   double angle_increment = 0.0;   ///< bearing step between beams (rad), non-zero, may be < 0
   double range_min = 0.0;         ///< readings below are invalid (m)
   double range_max = 0.0;         ///< readings at or above are "no return" (m)
+  /// Time since the previous scan of the same laser (s), for PolicyParams::forget_half_life;
+  /// 0, negative or non-finite: unknown (the scan then forgets by gamma).
+  double period = 0.0;
 };
 
 /// Integer index of a finest cell: cell (ix, iy) covers [ix, ix+1) x [iy, iy+1) * resolution.

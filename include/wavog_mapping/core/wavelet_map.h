@@ -100,6 +100,12 @@ class WaveletMap {
 
   const MapParams& params() const;
   double resolution() const;
+  /// The forgetting rate g a scan of `period` seconds applies (ScanView::period): gamma without
+  /// forget_half_life (or with an unknown period), else 1 - 2^(-period / forget_half_life) with
+  /// the exponent rounded to a multiple of forgetUnit(); 0 for policies other than "forget".
+  double forgetRate(double period) const;
+  /// forget_half_life only: the unit (in halvings) that each scan's exponent is rounded to.
+  double forgetUnit() const;
 
   /// Integrates one scan taken from `sensor_pose` (map frame). Beams are classified per REP 117;
   /// every cell in the field of view is updated at most once. Readings at or beyond the hard
