@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
     spinner.spin();
   } catch (const std::exception& e) {
     ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
+    // Stop roscpp's threads before the statics they use are destroyed.
+    ros::shutdown();
     return 1;
   }
   return 0;
