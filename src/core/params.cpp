@@ -91,11 +91,9 @@ std::vector<std::string> MapParams::validate() const {
         sensor.no_return_clear, ">= 0 m (0: no-return beams clear nothing)", &v);
   check(finite(policy.gamma) && policy.gamma > 0.0 && policy.gamma <= 1.0, "gamma", policy.gamma,
         "in (0, 1]", &v);
-  check(policy.forget_half_life == 0.0 ||
-            (finite(policy.forget_half_life) && policy.forget_half_life >= 1e-3 &&
-             policy.forget_half_life <= 1e6),
-        "forget_half_life", policy.forget_half_life, "0 (off: gamma per scan) or in [0.001, 1e6] s",
-        &v);
+  check(finite(policy.forget_half_life) && policy.forget_half_life >= 0.0 &&
+            policy.forget_half_life <= 1e6,
+        "forget_half_life", policy.forget_half_life, "in [0, 1e6] s (0: off, gamma per scan)", &v);
   check(finite(policy.clamp_min) && policy.clamp_min < 0.0, "clamp_min", policy.clamp_min,
         "< 0 log-odds", &v);
   check(finite(policy.clamp_max) && policy.clamp_max > 0.0, "clamp_max", policy.clamp_max,

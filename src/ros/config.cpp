@@ -111,6 +111,8 @@ const std::vector<KeyReader>& readers() {
       // ---- core: policy
       {"policy", [](auto&, auto&, Config*) {}},
       {"gamma", [](auto& k, auto& v, Config* c) { c->map.policy.gamma = asDouble(k, v); }},
+      {"forget_half_life",
+       [](auto& k, auto& v, Config* c) { c->map.policy.forget_half_life = asDouble(k, v); }},
       {"clamp_min", [](auto& k, auto& v, Config* c) { c->map.policy.clamp_min = asDouble(k, v); }},
       {"clamp_max", [](auto& k, auto& v, Config* c) { c->map.policy.clamp_max = asDouble(k, v); }},
       {"init",

@@ -32,6 +32,7 @@
 #include "wavog_mapping/MappingConfig.h"
 #include "wavog_mapping/SaveMap.h"
 #include "wavog_mapping/core/motion_compensation.h"
+#include "wavog_mapping/core/scan_period.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/ros/config.h"
 #include "wavog_mapping/ros/mapping_ros.h"
@@ -56,6 +57,7 @@ struct Input {
   double max_freq = 0.0;
   diagnostic_updater::FrequencyStatus* freq = nullptr;  ///< owned by Impl::freq_; may be null
   bool slash_warned = false;  ///< the leading-'/' warning was given (guarded by Impl::mutex_)
+  wavog::ScanPeriod period;   ///< of this laser's scans, for forget_half_life (Impl::mutex_)
   /// Scans handed to the tf filter and not yet out of it (integrated, dropped or flushed), oldest
   /// first; whoever removes a scan from here owns it. Guarded by Impl::mutex_. At most about
   /// queue_size long: the filter reports every scan it drops.

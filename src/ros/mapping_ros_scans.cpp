@@ -184,7 +184,8 @@ bool MappingRos::Impl::takePendingLocked(Input* in, const sensor_msgs::LaserScan
 void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& scan,
                                        const ScanPlacement& placement) {
   wavog::Pose2 pose;
-  const wavog::ScanView view = placement.placedView(scan, &compensator_, &pose);
+  wavog::ScanView view = placement.placedView(scan, &compensator_, &pose);
+  view.period = in->period.next(scan.header.stamp.toSec(), scan.scan_time);
   const auto t0 = Clock::now();
   const wavog::IntegrateStats st = map_.integrate(pose, view);
   const double dt = std::chrono::duration<double>(Clock::now() - t0).count();

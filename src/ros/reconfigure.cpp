@@ -18,6 +18,8 @@ struct NumberField {
 
 const NumberField kNumbers[] = {
     {&wavog_mapping::MappingConfig::gamma, [](Config& c) -> double& { return c.map.policy.gamma; }},
+    {&wavog_mapping::MappingConfig::forget_half_life,
+     [](Config& c) -> double& { return c.map.policy.forget_half_life; }},
     {&wavog_mapping::MappingConfig::clamp_min,
      [](Config& c) -> double& { return c.map.policy.clamp_min; }},
     {&wavog_mapping::MappingConfig::clamp_max,

@@ -28,6 +28,7 @@
 
 #include "offline.h"
 #include "wavog_mapping/core/motion_compensation.h"
+#include "wavog_mapping/core/scan_period.h"
 #include "wavog_mapping/io/carmen_reader.h"
 #include "wavog_mapping/ros/conversions.h"
 #include "wavog_mapping/ros/scan_placement.h"
@@ -136,6 +137,7 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   Session& s = **session;
   std::string first_tf_error;
   std::set<std::string> scan_frames;
+  std::map<std::string, wavog::ScanPeriod> periods;  // per topic, for forget_half_life
   std::set<std::string> slash_warned;  // topics whose frame_id had a leading '/'
   wavog::MotionCompensator compensator;
   wavog_ros::PlacementOptions placement_options;
@@ -174,7 +176,8 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
     info.motion_fallbacks += placement.motion_fallback ? 1 : 0;
     info.motion_compensated += placement.compensate ? 1 : 0;
     wavog::Pose2 pose;
-    const wavog::ScanView view = placement.placedView(*scan, &compensator, &pose);
+    wavog::ScanView view = placement.placedView(*scan, &compensator, &pose);
+    view.period = periods[m.getTopic()].next(scan->header.stamp.toSec(), scan->scan_time);
     s.integrate(pose, view, scan->header.stamp.toSec());
   }
   s.finish();
@@ -215,11 +218,14 @@ InputInfo runCarmen(const Options& o, const wavog_ros::Config& config,
   Session& s = **session;
   wavog::CarmenReader reader(o.input, false);
   wavog::CarmenScan scan;
+  std::map<std::string, wavog::ScanPeriod> periods;  // per laser, for forget_half_life
   try {
     // Read on to the end (not just `total` scans), so that a truncated stream is reported.
     while ((o.max_scans == 0 || s.done() < o.max_scans) && reader.next(&scan)) {
       if (plan.laserFor(scan.type) == nullptr) continue;
-      s.integrate(scan.laser_pose, scan.view(0.0), scan.ipc_timestamp);
+      wavog::ScanView view = scan.view(0.0);
+      view.period = periods[scan.type].next(scan.ipc_timestamp);
+      s.integrate(scan.laser_pose, view, scan.ipc_timestamp);
     }
   } catch (const std::runtime_error& e) {
     info.read_error = e.what();

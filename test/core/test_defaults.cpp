@@ -35,6 +35,7 @@ std::map<std::string, std::string> coreDefaults() {
           {"block_levels", num(d.grid.block_levels)},
           {"policy", wavog::toString(d.policy.type)},
           {"gamma", num(d.policy.gamma)},
+          {"forget_half_life", num(d.policy.forget_half_life)},
           {"clamp_min", num(d.policy.clamp_min)},
           {"clamp_max", num(d.policy.clamp_max)},
           {"init", wavog::toString(d.policy.init)},
@@ -119,7 +120,7 @@ TEST(Defaults, ReconfigureDefaultsRepeatTheFieldInitialisers) {
     EXPECT_EQ(normalised((*it)[2]), defaults.at(name)) << name;
     ++checked;
   }
-  EXPECT_EQ(checked, 5);  // gamma, clamp_min, clamp_max, odd_occ, odd_emp
+  EXPECT_EQ(checked, 6);  // gamma, forget_half_life, clamp_min, clamp_max, odd_occ, odd_emp
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "dense_reference.h"
+#include "wavog_mapping/core/scan_period.h"
 #include "test_support.h"
 
 namespace wavog_test {
@@ -59,15 +60,17 @@ TEST(ForgetHalfLife, RateFollowsThePeriodWithinHalfAUnit) {
 }
 
 TEST(ForgetHalfLife, InvalidHalfLifeIsRefusedNamingIt) {
-  for (double h : {-1.0, 1e-4, 2e6, std::nan(""), HUGE_VAL}) {
+  for (double h : {-1.0, -1e-9, 2e6, std::nan(""), HUGE_VAL}) {
     MapParams p = halfLifeParams(h);
     const auto errors = p.validate();
     ASSERT_EQ(errors.size(), 1u) << h;
     EXPECT_NE(errors[0].find("forget_half_life"), std::string::npos) << errors[0];
-    EXPECT_NE(errors[0].find("[0.001, 1e6] s"), std::string::npos) << errors[0];
+    EXPECT_NE(errors[0].find("[0, 1e6] s"), std::string::npos) << errors[0];
   }
   EXPECT_TRUE(halfLifeParams(0.0).validate().empty());
-  EXPECT_TRUE(halfLifeParams(1e-3).validate().empty());
+  EXPECT_TRUE(halfLifeParams(1e6).validate().empty());
+  // A half-life far below any scan period forgets everything at each scan.
+  EXPECT_GT(WaveletMap(halfLifeParams(1e-9)).forgetRate(0.025), 0.999999);
 }
 
 // Random scans, each with a random period (some unknown): the lazy tree, the eager tree and the
@@ -212,6 +215,21 @@ TEST(ForgetHalfLife, FilesOfFormatVersion1StillLoad) {
   // Fixed-gamma maps are what they were before forget_half_life, bit for bit.
   expectSameCells(loaded, made, 40, 0.0);
   EXPECT_EQ(loaded.stats().nodes, made.stats().nodes);
+}
+
+TEST(ScanPeriod, StampDifferencesThenTheDriversScanTimeThenUnknown) {
+  constexpr double kEps = 1e-9;
+  wavog::ScanPeriod period;
+  EXPECT_EQ(period.next(100.0), 0.0);                      // the first scan: unknown
+  EXPECT_NEAR(period.next(100.025, 0.5), 0.025, kEps);     // stamps first
+  EXPECT_NEAR(period.next(100.125, 0.025), 0.1, kEps);     // a dropped scan is time that passed
+  EXPECT_EQ(period.next(105.0, 0.025), 0.025);             // a gap over kMaxPeriod: scan_time
+  EXPECT_EQ(period.next(110.0), 0.0);                      // a gap, no scan_time: unknown
+  EXPECT_EQ(period.next(109.0), 0.0);                      // backwards: unknown
+  EXPECT_NEAR(period.next(109.04), 0.04, kEps);            // on from the backward stamp
+  EXPECT_EQ(period.next(std::nan(""), 0.0), 0.0);          // a non-finite stamp
+  EXPECT_EQ(period.next(109.1, 5.0), 0.0);                 // after it; scan_time too long
+  EXPECT_NEAR(period.next(109.2), 0.1, kEps);
 }
 
 }  // namespace

@@ -69,8 +69,8 @@ struct PolicyParams {
   /// Forgetting rate gamma of eq. 1.6, in (0, 1]; used by "forget" only (paper: 0.3 at 10 Hz).
   /// With forget_half_life, only for scans whose period is unknown.
   double gamma = 0.3;
-  /// "forget" only: half-life (s) of what a cell remembers while it is observed, 0 = off (each
-  /// scan forgets by gamma, whatever its rate), else in [0.001, 1e6]. A scan of period dt
+  /// "forget" only: half-life (s) of what a cell remembers while it is observed, in [0, 1e6];
+  /// 0 = off (each scan forgets by gamma, whatever its rate). A scan of period dt
   /// (ScanView::period) then forgets by g = 1 - 2^(-dt / forget_half_life), so that lasers of any
   /// rate forget at the same rate per second. The exponent dt / forget_half_life of each scan is
   /// rounded to a multiple of the map's forgetting unit (WaveletMap::forgetUnit(), 2^-11 with
