@@ -15,10 +15,11 @@ namespace {
 constexpr std::size_t kLentGroups = 64;
 }  // namespace
 
-WaveletMap::Impl::Impl(const MapParams& p) : params(p) {
-  throwIfInvalid(p);
+WaveletMap::Impl::Impl(const MapParams& p, bool validate) : params(p) {
+  if (validate) throwIfInvalid(p);
   levels = p.grid.block_levels;
   configure();
+  configureLayers();
 }
 
 void WaveletMap::Impl::configure() {
@@ -31,13 +32,16 @@ void WaveletMap::Impl::configure() {
   // Section 6.5: all values stay in [odd_emp, odd_occ], so |d| <= 2R; once the pending
   // multiplier is below tau / 2R every detail of the subtree is below the pruning threshold and
   // the subtree can go.
-  const double halvings = std::log2(2.0 * (params.sensor.odd_occ - params.sensor.odd_emp) /
-                                    prune_threshold);
+  const double halvings =
+      std::log2(2.0 * (params.sensor.odd_occ - params.sensor.odd_emp) / prune_threshold);
   half_life = forget && params.policy.forget_half_life > 0.0;
   if (half_life) {
-    // The finest unit 2^-e for which the negligible multiplier still fits a 16-bit count.
-    constexpr double kMaxCount = 65535.0;
-    const int e = std::min(16, static_cast<int>(std::floor(std::log2(kMaxCount / halvings))));
+    // The finest unit 2^-e for which the negligible multiplier of the widest odd range (100:
+    // odd_occ <= 50, odd_emp >= -50) still fits a 16-bit count; it depends on tau only, so a
+    // map and its reflection layers share it (and so each scan's factor).
+    constexpr double kMaxCount = 65535.0, kWidestRange = 100.0;
+    const double widest = std::log2(2.0 * kWidestRange / prune_threshold);
+    const int e = std::min(16, static_cast<int>(std::floor(std::log2(kMaxCount / widest))));
     unit_log2 = std::ldexp(1.0, -e);
     k_cap = 65535;
     k_star = static_cast<int>(std::ceil(halvings / unit_log2));

@@ -51,7 +51,7 @@ struct Input {
   std::string topic;  ///< resolved name
   ros::Subscriber sub;
   std::unique_ptr<ScanFilter> filter;
-  InputCounters c;  ///< guarded by Impl::mutex_
+  InputCounters c;                                           ///< guarded by Impl::mutex_
   std::array<ros::WallTime, kNumDropReasons + 1> last_warn;  ///< + 1: time jumps, fallbacks
   double min_freq = 0.0;  ///< diagnostics bounds (the FrequencyStatus keeps pointers to them)
   double max_freq = 0.0;

@@ -55,7 +55,8 @@ TEST(HalfLifeRates, InputsOfDifferentRatesForgetAlikePerSecond) {
     const int wall_scans = static_cast<int>(std::lround(1.0 / periods[k]));
     const int gone_scans = static_cast<int>(std::lround(0.3 / periods[k]));
     for (int i = 0; i < wall_scans + gone_scans; ++i) {
-      auto scan = room::scanOf(sensors[static_cast<std::size_t>(k)], t0 + ros::Duration(i * periods[k]));
+      auto scan =
+          room::scanOf(sensors[static_cast<std::size_t>(k)], t0 + ros::Duration(i * periods[k]));
       if (i >= wall_scans) {
         for (float& r : scan->ranges) r += 1.0f;  // the wall has gone 1 m back
       }
@@ -67,7 +68,8 @@ TEST(HalfLifeRates, InputsOfDifferentRatesForgetAlikePerSecond) {
   const auto status = room::waitLatest(
       &g_mutex, &g_status,
       [&](const wavog_mapping::MapperStatus& s) {
-        return s.inputs.size() == 2 && s.inputs[0].integrated == static_cast<unsigned>(published[0]) &&
+        return s.inputs.size() == 2 &&
+               s.inputs[0].integrated == static_cast<unsigned>(published[0]) &&
                s.inputs[1].integrated == static_cast<unsigned>(published[1]);
       },
       30.0);
