@@ -237,5 +237,37 @@ TEST(Reflection, FilesClearingResetAndPolicyChanges) {
   std::remove(path.c_str());
 }
 
+// Section 6.5 for the layers: a region seen empty long enough loses its detail in the hits and
+// misses trees too (their odd values are 0 and 1, in either order).
+TEST(Reflection, LongEmptyRunsCollapseTheLayersWithForgetting) {
+  MapParams p = reflectionParams(PolicyType::kForget, 0.1, 5);
+  p.sensor.no_return_clear = 12.0;  // the empty scans below clear without hits
+  WaveletMap map(p);
+  RandomScans scans(3u, 6.0);
+  for (int i = 0; i < 60; ++i) {
+    const OwnedScan s = scans.next();
+    map.integrate(s.pose, s.view());
+  }
+  const auto occupancyBytes = [&] { return map.stats().bytes - map.stats().reflection_bytes; };
+  const double layers_before = static_cast<double>(map.stats().reflection_bytes);
+  const double main_before = static_cast<double>(occupancyBytes());
+  // Full circles from the origin with no return: free up to 12 m, no hit anywhere.
+  OwnedScan empty;
+  empty.angle_min = -3.14159;
+  empty.angle_increment = 2 * 3.14159 / 2000;
+  empty.range_min = 0.05;
+  empty.range_max = 40.0;
+  empty.ranges.assign(2000, std::numeric_limits<float>::infinity());
+  for (int i = 0; i < 120; ++i) map.integrate(empty.pose, empty.view());
+  // The two layers shrink as the occupancy tree does (which section 6.5 collapses).
+  const double layers_ratio = static_cast<double>(map.stats().reflection_bytes) / layers_before;
+  const double main_ratio = static_cast<double>(occupancyBytes()) / main_before;
+  EXPECT_LT(main_ratio, 0.5);
+  EXPECT_LT(layers_ratio, 1.25 * main_ratio)
+      << "layers " << layers_before << " -> " << map.stats().reflection_bytes << " bytes, map "
+      << main_before << " -> " << occupancyBytes();
+  EXPECT_NEAR(map.reflection(map.cellAt(1.05, 2.05)), 0.0, 1e-6);
+}
+
 }  // namespace
 }  // namespace wavog_test
