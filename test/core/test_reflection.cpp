@@ -16,7 +16,6 @@
 
 #include "dense_reference.h"
 #include "test_support.h"
-#include "wavog_mapping/io/carmen_reader.h"
 
 namespace wavog_test {
 namespace {
@@ -128,27 +127,14 @@ TEST(Reflection, RandomScansEveryPolicyEveryScale) {
 }
 
 TEST(Reflection, Fr079FirstScansEveryPolicy) {
-  const std::string dir = dataDir();
-  ASSERT_FALSE(dir.empty());
-  const auto log = wavog::readCarmenLog(dir + "/fr079-corrected.log.gz", 300);
+  const std::vector<OwnedScan> log = fr079Scans(300);
   ASSERT_EQ(log.size(), 300u);
-  const double res = 0.1;
   // The area of the first scans (fr079's first poses are near the origin, ranges < 50 m).
   const CellBox extent{-500, -500, 500, 500};
   for (PolicyType type : {PolicyType::kNone, PolicyType::kMax, PolicyType::kForget}) {
     SCOPED_TRACE(wavog::toString(type));
-    ReflectionRun run(reflectionParams(type, res, 6), extent);
-    for (const auto& s : log) {
-      OwnedScan o;
-      o.pose = s.laser_pose;
-      const auto v = s.view();
-      o.ranges.assign(v.ranges, v.ranges + v.count);
-      o.angle_min = v.angle_min;
-      o.angle_increment = v.angle_increment;
-      o.range_min = v.range_min;
-      o.range_max = v.range_max;
-      run.integrate(o);
-    }
+    ReflectionRun run(reflectionParams(type, 0.1, 6), extent);
+    for (const OwnedScan& s : log) run.integrate(s);
     expectSameReflection(run.map, &run.ref, run.hits_only, 4, wavog::toString(type));
   }
 }
