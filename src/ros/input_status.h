@@ -21,6 +21,7 @@ namespace wavog_ros {
 enum class Counter : std::size_t {
   kReceived,
   kIntegrated,
+  kLost,          ///< never received: gaps in header.seq (SeqGapCounter)
   kDroppedFirst,  ///< + DropReason: dropped_empty ... dropped_bad_geometry
   kTimeJumps = kDroppedFirst + kNumDropReasons,
   kMotionFallbacks,
@@ -36,6 +37,28 @@ constexpr Counter droppedCounter(DropReason reason) {
                               static_cast<std::size_t>(reason));
 }
 
+/// Scans lost before the node received them (roscpp's subscriber queue drops the oldest scan when
+/// the node is slower than the input, and tells nobody), from the gaps in header.seq of what is
+/// received. Drivers and rosbag keep seq; a publisher whose seq is always 0, or does not increase
+/// by 1, must not produce false counts: a gap counts only once seq has increased by exactly 1 from
+/// the same publisher, and trust is lost again when seq stands still or goes back (a restarted
+/// bag or driver) or the publisher changes.
+class SeqGapCounter {
+ public:
+  /// A forward step larger than this is a restart (a new seq base), not a loss.
+  static constexpr std::uint32_t kMaxGap = 100000;
+
+  /// The next received scan: its seq and its publisher (callerid). Returns how many scans are
+  /// missing between the previous one and this one (0 while seq is not trusted).
+  std::uint32_t next(std::uint32_t seq, const std::string& publisher);
+
+ private:
+  bool have_ = false;     ///< a previous scan was seen
+  bool trusted_ = false;  ///< seq increased by exactly 1 since the last reset
+  std::uint32_t last_ = 0;
+  std::string publisher_;
+};
+
 /// Counters and clocks of one input since start-up.
 struct InputCounters {
   std::array<std::uint64_t, kNumCounters> count{};
@@ -44,6 +67,7 @@ struct InputCounters {
   ros::Time last_received_stamp;         ///< of the last received scan (time-jump check)
   ros::Time last_receipt;                ///< clock time of the last receipt (stale check)
   double rate = 0.0;                     ///< measured over the last status period (Hz)
+  SeqGapCounter seq;                     ///< Counter::kLost from header.seq
 
   std::uint64_t& operator[](Counter c) { return count[static_cast<std::size_t>(c)]; }
   std::uint64_t operator[](Counter c) const { return count[static_cast<std::size_t>(c)]; }

@@ -12,9 +12,6 @@
 namespace wavog_ros {
 namespace {
 
-/// Subscriber queue per input: bursts (several drivers on one host) must not be lost before the
-/// scans reach the tf MessageFilter, whose own queue is the queue_size parameter.
-constexpr std::uint32_t kSubscriberQueue = 50;
 /// Period (s) of the /diagnostics updater.
 constexpr double kDiagnosticsPeriod = 0.5;
 
@@ -114,11 +111,15 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
             guarded("tf filter failure callback", nullptr,
                     [&] { onFilterFailure(raw, scan, reason); });
           }));
+  // The subscriber queue (subscriber_queue_size) holds bursts (several drivers on one host, fast
+  // playback) until onScan runs; roscpp drops its oldest scan silently when it is full, which
+  // onScan counts from the gaps in header.seq. The event carries the publisher for that check.
   in->sub = nh_.subscribe<LaserScan>(
-      ic.topic, kSubscriberQueue,
-      boost::function<void(const LaserScan::ConstPtr&)>(
-          [this, raw](const LaserScan::ConstPtr& scan) {
-            guarded("scan callback", raw, [&] { onScan(raw, scan); });
+      ic.topic, static_cast<std::uint32_t>(rp.subscriber_queue_size),
+      boost::function<void(const ros::MessageEvent<const LaserScan>&)>(
+          [this, raw](const ros::MessageEvent<const LaserScan>& event) {
+            guarded("scan callback", raw,
+                    [&] { onScan(raw, event.getConstMessage(), event.getPublisherName()); });
           }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   updater_->add(in->topic + " input", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {
