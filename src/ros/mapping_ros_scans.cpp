@@ -172,8 +172,12 @@ void MappingRos::Impl::onFilterFailure(
   } else if (reason == tf2_ros::filter_failure_reasons::EmptyFrameID) {
     dropLocked(in, DropReason::kBadFrame, "empty frame_id");
   } else {
+    // Unknown: tf never came in time, or the filter's queue overflowed (it drops its oldest scan
+    // when more than queue_size wait for tf).
     dropLocked(in, DropReason::kTfUnavailable,
-               "no transform to '" + placement_.fixed_frame + "' (unknown frame or tf late)");
+               "no transform to '" + placement_.fixed_frame +
+                   "' (unknown frame, tf late, or more than queue_size " +
+                   std::to_string(config_.ros.queue_size) + " scans waiting for tf)");
   }
 }
 

@@ -104,12 +104,12 @@ TEST(Playback, NodeMapAgreesWithOfflineMap) {
       << "the node received " << received << " and counted " << input.lost << " lost of " << n
       << " scans: the bag holds more than " << n << "?\n" << input;
   ASSERT_EQ(received, n) << n - received << " of " << n
-                         << " scans never reached the node's callback (" << input.lost
-                         << " counted as lost from header.seq gaps: the subscriber queue, "
-                            "subscriber_queue_size, overflowed; "
+                         << " scans never reached the node's callback, most likely dropped by its "
+                            "full subscriber queue (subscriber_queue_size): "
+                         << input.lost << " of them counted as lost (header.seq gaps), "
                          << n - received - input.lost
-                         << " uncounted, the bag's seq not increasing by 1); maps not compared. "
-                            "Last status of the input:\n"
+                         << " not counted (header.seq of this bag does not increase by 1); maps "
+                            "not compared. Last status of the input:\n"
                          << input;
   ASSERT_EQ(dropped, 0u) << dropped << " of " << n
                          << " scans dropped by the node (see the counters); maps not compared:\n"
