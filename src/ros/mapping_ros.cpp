@@ -12,6 +12,8 @@
 namespace wavog_ros {
 namespace {
 
+/// Smallest /tf and /tf_static subscriber queue (the size roscpp's TransformListener uses).
+constexpr int kMinTfQueue = 100;
 /// Period (s) of the /diagnostics updater.
 constexpr double kDiagnosticsPeriod = 0.5;
 
@@ -76,9 +78,13 @@ MappingRos::Impl::~Impl() {
 void MappingRos::Impl::subscribeTf() {
   buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(config_.ros.tf_cache_time));
   ros::NodeHandle root;
+  // As deep as the scans' queues: when the node stalls, roscpp would otherwise drop the oldest tf
+  // and hand the queued scans a buffer that has moved on (they would be dropped as tf too old).
+  const auto queue =
+      static_cast<std::uint32_t>(std::max(kMinTfQueue, config_.ros.subscriber_queue_size));
   for (const bool is_static : {false, true}) {
     (is_static ? tf_static_sub_ : tf_sub_) = root.subscribe<tf2_msgs::TFMessage>(
-        is_static ? "/tf_static" : "/tf", 100,
+        is_static ? "/tf_static" : "/tf", queue,
         boost::function<void(const tf2_msgs::TFMessage::ConstPtr&)>(
             [this, is_static](const tf2_msgs::TFMessage::ConstPtr& m) {
               guarded("tf callback", nullptr, [&] { onTf(m, is_static); });

@@ -55,7 +55,8 @@ struct RosParams {
   int queue_size = 20;
   /// Scans per input roscpp holds between the socket and the node's callback, in [1, 100000].
   /// roscpp silently drops the oldest when it is full (the node is slower than the input); the
-  /// node counts those from gaps in header.seq (InputStatus::lost).
+  /// node counts those from gaps in header.seq (InputStatus::lost). /tf and /tf_static get
+  /// queues as deep (at least 100), so queued scans find their tf after a stall.
   int subscriber_queue_size = 1000;
   /// Place each beam with the sensor pose interpolated over the sweep (needs time_increment).
   bool motion_compensation = true;
