@@ -111,6 +111,17 @@ if(CATKIN_ENABLE_TESTING)
       WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
 
     # Sim time jumping backwards (bag restart): tf buffer cleared, mapping goes on.
+    add_rostest_gtest(test_half_life_rates test/half_life_rates.test
+      test/ros/test_half_life_rates.cpp)
+    target_include_directories(test_half_life_rates SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(test_half_life_rates ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_half_life_rates ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    add_rostest_gtest(test_reflection_topics test/reflection_topics.test
+      test/ros/test_reflection_topics.cpp)
+    target_include_directories(test_reflection_topics SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(test_reflection_topics ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_reflection_topics ${PROJECT_NAME}_generate_messages_cpp
+      ${WAVOG_ROS_RUNTIME})
     add_rostest_gtest(test_clock_jump test/clock_jump.test test/ros/test_clock_jump.cpp)
     target_include_directories(test_clock_jump SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
     target_link_libraries(test_clock_jump ${catkin_LIBRARIES} ${GTEST_LIBRARIES})

@@ -8,6 +8,8 @@ Reads DIR/figure_data/figures.json, DIR/figure_data/maps/*.png and DIR/figure_da
   policies.png    the final map of every policy side by side (x, y in metres)
   departure.png   the departed car's mean P(occupied) against time, one line per policy
   arrival.png     the same for the arrived car (further events: departure_<k>.png, ...)
+  reflection_departure.png, reflection_arrival.png
+                  with wavog_evaluate --reflection: the cars' mean reflection p the same way
 Needs matplotlib (Debian: python3-matplotlib); `make demo` runs it.
 """
 
@@ -34,14 +36,18 @@ COLUMNS = 3
 def load(data_dir):
     with open(os.path.join(data_dir, "figures.json")) as f:
         figures = json.load(f)
-    series = {}
+    series, reflection = {}, {}
     with open(os.path.join(data_dir, "responses.csv"), newline="") as f:
         for row in csv.DictReader(f):
             key = (int(row["event"]), row["policy"])
             times, values = series.setdefault(key, ([], []))
             times.append(float(row["time_s"]))
             values.append(float(row["mean_p_occ"]))
-    return figures, series
+            if row.get("mean_reflection_p"):  # wavog_evaluate --reflection
+                rt, rv = reflection.setdefault(key, ([], []))
+                rt.append(float(row["time_s"]))
+                rv.append(float(row["mean_reflection_p"]))
+    return figures, series, reflection
 
 
 def plot_policies(figures, data_dir, out_path):
@@ -73,7 +79,7 @@ def plot_policies(figures, data_dir, out_path):
     plt.close(fig)
 
 
-def plot_event(k, event, figures, series, out_path):
+def plot_event(k, event, figures, series, out_path, quantity="P(occupied)"):
     departure = event["type"] == "departure"
     fig, ax = plt.subplots(figsize=(10, 4.6), constrained_layout=True)
     t0 = max(0.0, event["start_s"] - 2.0)
@@ -90,9 +96,10 @@ def plot_event(k, event, figures, series, out_path):
     ax.set_xlim(t0, figures["t_end_s"])
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlabel("time (s)")
-    ax.set_ylabel("mean P(occupied) of the car's cells")
-    ax.set_title("%s car '%s': mean P(occupied) of its %d cells against time"
-                 % ("Departed" if departure else "Arrived", event["name"], event["cells"]))
+    ax.set_ylabel("mean %s of the car's cells" % quantity)
+    ax.set_title("%s car '%s': mean %s of its %d cells against time"
+                 % ("Departed" if departure else "Arrived", event["name"], quantity,
+                    event["cells"]))
     ax.grid(True, color="0.9")
     ax.legend(title="policy / initial value", loc="center left", bbox_to_anchor=(1.01, 0.5),
               frameon=False)
@@ -102,12 +109,15 @@ def plot_event(k, event, figures, series, out_path):
 
 def draw(out_dir):
     data_dir = os.path.join(out_dir, "figure_data")
-    figures, series = load(data_dir)
+    figures, series, reflection = load(data_dir)
     written = [os.path.join(out_dir, "policies.png")]
     plot_policies(figures, data_dir, written[0])
     for k, event in enumerate(figures["events"]):
         written.append(os.path.join(out_dir, event["figure"]))
         plot_event(k, event, figures, series, written[-1])
+        if any(key[0] == k for key in reflection):
+            written.append(os.path.join(out_dir, "reflection_" + event["figure"]))
+            plot_event(k, event, figures, reflection, written[-1], "reflection p")
     return written
 
 

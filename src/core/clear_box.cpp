@@ -54,6 +54,9 @@ double clearNode(WaveletMap::Impl& impl, detail::NodeStore& store, Node& n, int 
 std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y) {
   if (!(min_x <= max_x && min_y <= max_y)) return 0;  // also rejects NaN
   Impl& impl = *impl_;
+  for (WaveletMap* layer : {impl.hits.get(), impl.misses.get()}) {
+    if (layer != nullptr) layer->clearBox(min_x, min_y, max_x, max_y);
+  }
   const double r = impl.params.grid.resolution;
   // Cells whose centre (i + 0.5) r lies in [min, max], clamped to one cell beyond the extent on
   // each side (no block lies there), so any bounds, +-inf included, convert exactly.

@@ -90,9 +90,10 @@ template <PolicyType P>
   return integrator.visited();
 }
 
+// `workers`: the map's worker threads (made here on first use), shared by its reflection layers.
 template <PolicyType P>
 std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, double period,
-                           IntegrateStats* st) {
+                           std::unique_ptr<detail::WorkerPool>* workers, IntegrateStats* st) {
   const MapParams& p = impl.params;
   // Forgetting: gamma per scan, or from the scan's period with forget_half_life.
   const unsigned units = impl.scanUnits(period);
@@ -138,8 +139,8 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     return visited + updateBlocks<P>(impl, store, cls, pc, jobs, &next);
   }
   orderByWork(ps, block_size, &jobs);
-  if (!impl.workers || impl.workers->threads() != threadsFor(p)) {
-    impl.workers = std::make_unique<detail::WorkerPool>(threadsFor(p));
+  if (!*workers || (*workers)->threads() != threadsFor(p)) {
+    *workers = std::make_unique<detail::WorkerPool>(threadsFor(p));
   }
   // Per participant: visits and node / group count changes (modulo 2^64), on their own cache
   // lines.
@@ -147,9 +148,9 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     std::uint64_t visited = 0;
     std::size_t nodes = 0, groups = 0;
   };
-  std::vector<Tally> tallies(static_cast<std::size_t>(impl.workers->threads()));
+  std::vector<Tally> tallies(static_cast<std::size_t>((*workers)->threads()));
   const auto active = static_cast<std::size_t>(threads);
-  impl.workers->run([&](int t) {
+  (*workers)->run([&](int t) {
     const auto tu = static_cast<std::size_t>(t);
     if (tu >= active) return;
     Tally& tally = tallies[tu];
@@ -166,7 +167,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
 
 // One instantiation per policy, in the order of PolicyType's enumerators.
 using IntegrateFn = std::uint64_t (*)(WaveletMap::Impl&, const ScanClassifier&, double,
-                                      IntegrateStats*);
+                                      std::unique_ptr<detail::WorkerPool>*, IntegrateStats*);
 constexpr IntegrateFn kIntegrateFor[] = {
     &integrateAll<PolicyType::kNone>,       &integrateAll<PolicyType::kMax>,
     &integrateAll<PolicyType::kClamp>,      &integrateAll<PolicyType::kForget>,
@@ -191,7 +192,15 @@ IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& s
   const detail::PreparedScan& ps = classifier.scan();
   st.touched = reachBox(ps.px, ps.py, ps.reach, ps.res);
   const auto policy = static_cast<std::size_t>(impl_->params.policy.type);
-  st.nodes_visited = kIntegrateFor[policy](*impl_, classifier, scan.period, &st);
+  st.nodes_visited = kIntegrateFor[policy](*impl_, classifier, scan.period, &impl_->workers, &st);
+  // The reflection layers (reflection.cpp) take the same classification and blocks.
+  for (WaveletMap* layer : {impl_->hits.get(), impl_->misses.get()}) {
+    if (layer == nullptr) continue;
+    Impl& l = *layer->impl_;
+    IntegrateStats layer_st;
+    l.nodes_visited_last = kIntegrateFor[static_cast<std::size_t>(l.params.policy.type)](
+        l, classifier, scan.period, &impl_->workers, &layer_st);
+  }
   classifier.releaseIfLarge();
   impl_->nodes_visited_last = st.nodes_visited;
   return st;

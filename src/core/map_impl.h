@@ -27,7 +27,9 @@ inline std::uint8_t withBit(unsigned mask, unsigned bit, bool on) {
 
 /// Everything a WaveletMap holds. Members are public to the core's own translation units.
 struct WaveletMap::Impl {
-  explicit Impl(const MapParams& p);
+  /// `validate`: throw std::invalid_argument for invalid parameters (a reflection layer's are
+  /// made by the core and are outside the users' ranges).
+  explicit Impl(const MapParams& p, bool validate = true);
 
   MapParams params;
   int levels = 0;                 ///< block_levels
@@ -55,6 +57,9 @@ struct WaveletMap::Impl {
   detail::BlockMap blocks;
   /// Worker threads of parallel integrations (num_threads != 1), made on the first one.
   std::unique_ptr<detail::WorkerPool> workers;
+  /// Reflection layers (MapParams::reflection, reflection.cpp): hits and misses of every cell as
+  /// two more maps, integrated with the same classification; `misses` is null under "max".
+  std::unique_ptr<WaveletMap> hits, misses;
   std::size_t nodes = 0;  ///< live nodes (roots included)
   std::uint64_t nodes_visited_last = 0;
 
@@ -109,6 +114,11 @@ struct WaveletMap::Impl {
   void addPending(detail::Node& n, unsigned m);
   /// Applies every pending tag in the map (before a policy change or a save).
   void flushAll();
+
+  /// Makes (or, after a policy change, re-parameterises) the reflection layers from params.
+  void configureLayers();
+  /// The parameters of reflection layer `hits` (else misses) of a map with `main`.
+  static MapParams layerParams(const MapParams& main, bool hits);
 
   /// True when node `n` (after an update) carries no information beyond its parent's summary:
   /// no child, negligible details, uniform knowledge.

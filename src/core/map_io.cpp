@@ -4,8 +4,11 @@
 //   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
 //              [root subtree, pre-order: f32 dx dy dxy (stored) | u16 pending count k |
 //               u8 child_mask | u8 known_all | u8 known_any | children in q order]
+//   u8 reflection layers n (0, 1: hits, 2: hits and misses), each: f64 a | u64 block count |
+//   blocks as above
 //   u32 CRC-32 (IEEE) of every byte before it.
-// Version 1 (before forget_half_life) is the same with a u8 pending count; it still loads.
+// Version 1 (before forget_half_life and reflection) is the same with a u8 pending count and no
+// layers; it still loads.
 // Stored details and lazy counts are written as they are, so a round trip is bit-exact; a map
 // loaded under another factor applies the file's pending tags while loading.
 // Files are written and read through map_file.h (exclusive temporary + rename, regular files only).
@@ -168,8 +171,11 @@ std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
   std::memcpy(&count, head.data() + kHeaderBytes - sizeof(count), sizeof(count));
   // A full block: its header and one node per level-l node of the quadtree, (4^L - 1) / 3.
   const double nodes_per_block = (std::ldexp(1.0, 2 * levels) - 1.0) / 3.0;
-  const double largest = static_cast<double>(kHeaderBytes + kCrcBytes) +
-                         static_cast<double>(count) *
+  // Version 2 may add two reflection layers over the same blocks (each with its unit factor and
+  // count, and the layer count byte).
+  const double maps = version >= 2 ? 3.0 : 1.0;
+  const double largest = static_cast<double>(kHeaderBytes + kCrcBytes) + (maps - 1.0) * 17.0 + 1.0 +
+                         maps * static_cast<double>(count) *
                              (static_cast<double>(kMinBlockBytes) +
                               nodes_per_block * static_cast<double>(nodeBytes(version)));
   if (static_cast<double>(size) > largest) {
@@ -183,6 +189,62 @@ std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
 
 }  // namespace
 
+namespace {
+
+// The blocks section of one map (the main map or a reflection layer): u64 count, then the blocks.
+void writeBlocks(const WaveletMap::Impl& impl, Writer* w) {
+  w->put(static_cast<std::uint64_t>(impl.blocks.size()));
+  for (const auto& kv : impl.blocks) {
+    const Block& b = kv.second;
+    w->put(static_cast<std::int32_t>(detail::blockKeyX(kv.first)));
+    w->put(static_cast<std::int32_t>(detail::blockKeyY(kv.first)));
+    w->put(b.s);
+    w->put(static_cast<std::uint8_t>((b.known_all ? 1 : 0) | (b.known_any ? 2 : 0) |
+                                     (b.has_root ? 4 : 0)));
+    if (b.has_root) writeNode(impl, b.root, impl.levels, w);
+  }
+}
+
+// Reads a blocks section into `fresh` (an empty map); `bytes`: the file's size, bounding the count.
+void readBlocks(WaveletMap::Impl& fresh, const PendingFormat& format, std::size_t bytes,
+                Reader* r) {
+  const auto count = r->get<std::uint64_t>();
+  if (count > bytes / kMinBlockBytes) {
+    throw std::runtime_error(std::to_string(count) + " blocks cannot fit in " +
+                             std::to_string(bytes) + " bytes");
+  }
+  for (std::uint64_t i = 0; i < count; ++i) {
+    const auto bx = r->get<std::int32_t>();
+    const auto by = r->get<std::int32_t>();
+    const auto s = r->get<double>();
+    const auto flags = r->get<std::uint8_t>();
+    if (!std::isfinite(s) || flags > 7) throw std::runtime_error("bad block header");
+    if (!inExtent(detail::scaleUp(bx, fresh.levels), detail::scaleUp(by, fresh.levels))) {
+      throw std::runtime_error("block (" + std::to_string(bx) + ", " + std::to_string(by) +
+                               ") outside the representable extent of +-2^30 cells");
+    }
+    auto ins = fresh.blocks.try_emplace(detail::blockKey(bx, by));
+    if (!ins.second) throw std::runtime_error("duplicate block");
+    Block& b = ins.first->second;
+    b.s = s;
+    b.known_all = flags & 1;
+    b.known_any = (flags & 2) != 0;
+    b.has_root = (flags & 4) != 0;
+    if (b.has_root) {
+      ++fresh.nodes;
+      readNode(fresh, b.root, fresh.levels, format, 0, r);
+    }
+  }
+}
+
+double readUnitFactor(Reader* r) {
+  const auto a = r->get<double>();
+  if (!(a >= 0.0 && a <= 1.0)) throw std::runtime_error("bad forgetting factor");
+  return a;
+}
+
+}  // namespace
+
 void WaveletMap::save(const std::string& path) const {
   const Impl& impl = *impl_;
   Writer w;
@@ -192,15 +254,16 @@ void WaveletMap::save(const std::string& path) const {
   w.put(static_cast<std::int32_t>(impl.levels));
   w.put(impl.init);
   w.put(impl.unitFactor());
-  w.put(static_cast<std::uint64_t>(impl.blocks.size()));
-  for (const auto& kv : impl.blocks) {
-    const Block& b = kv.second;
-    w.put(static_cast<std::int32_t>(detail::blockKeyX(kv.first)));
-    w.put(static_cast<std::int32_t>(detail::blockKeyY(kv.first)));
-    w.put(b.s);
-    w.put(static_cast<std::uint8_t>((b.known_all ? 1 : 0) | (b.known_any ? 2 : 0) |
-                                    (b.has_root ? 4 : 0)));
-    if (b.has_root) writeNode(impl, b.root, impl.levels, &w);
+  writeBlocks(impl, &w);
+  // Reflection layers: u8 count (0: none, 1: hits, 2: hits and misses), each its unit factor and
+  // its blocks.
+  const std::vector<const WaveletMap*> layers = {impl.hits.get(), impl.misses.get()};
+  const auto n = static_cast<std::uint8_t>((layers[0] != nullptr) + (layers[1] != nullptr));
+  w.put(n);
+  for (std::uint8_t i = 0; i < n; ++i) {
+    const Impl& l = *layers[i]->impl_;
+    w.put(l.unitFactor());
+    writeBlocks(l, &w);
   }
   auto& buf = w.buffer();
   const std::uint32_t crc = crc32(buf.data(), buf.size());
@@ -229,40 +292,27 @@ void WaveletMap::load(const std::string& path) {
     const auto res = r.get<double>();
     const auto levels = r.get<std::int32_t>();
     (void)r.get<double>();  // prior at save time: informative only
-    const auto file_a = r.get<double>();
-    if (!(file_a >= 0.0 && file_a <= 1.0)) throw std::runtime_error("bad forgetting factor");
-    const PendingFormat format{version, file_a, file_a == fresh.unitFactor()};
+    const double file_a = readUnitFactor(&r);
     if (res != impl_->params.grid.resolution || levels != impl_->levels) {
       std::ostringstream s;
       s << "its resolution " << res << " m / block_levels " << levels << " differ from this map's "
         << impl_->params.grid.resolution << " m / " << impl_->levels;
       throw fail(s.str());
     }
-    const auto count = r.get<std::uint64_t>();
-    if (count > (data.size() - kHeaderBytes - kCrcBytes) / kMinBlockBytes) {
-      throw std::runtime_error(std::to_string(count) + " blocks cannot fit in " +
-                               std::to_string(data.size()) + " bytes");
-    }
-    for (std::uint64_t i = 0; i < count; ++i) {
-      const auto bx = r.get<std::int32_t>();
-      const auto by = r.get<std::int32_t>();
-      const auto s = r.get<double>();
-      const auto flags = r.get<std::uint8_t>();
-      if (!std::isfinite(s) || flags > 7) throw std::runtime_error("bad block header");
-      if (!inExtent(detail::scaleUp(bx, fresh.levels), detail::scaleUp(by, fresh.levels))) {
-        throw std::runtime_error("block (" + std::to_string(bx) + ", " + std::to_string(by) +
-                                 ") outside the representable extent of +-2^30 cells");
-      }
-      auto ins = fresh.blocks.try_emplace(detail::blockKey(bx, by));
-      if (!ins.second) throw std::runtime_error("duplicate block");
-      Block& b = ins.first->second;
-      b.s = s;
-      b.known_all = flags & 1;
-      b.known_any = (flags & 2) != 0;
-      b.has_root = (flags & 4) != 0;
-      if (b.has_root) {
-        ++fresh.nodes;
-        readNode(fresh, b.root, fresh.levels, format, 0, &r);
+    readBlocks(fresh, PendingFormat{version, file_a, file_a == fresh.unitFactor()}, data.size(),
+               &r);
+    if (version >= 2) {
+      // Reflection layers: into this map's when it keeps them (a missing one stays empty), else
+      // read and dropped.
+      const auto n = r.get<std::uint8_t>();
+      if (n > 2) throw std::runtime_error("bad reflection layer count");
+      for (std::uint8_t i = 0; i < n; ++i) {
+        WaveletMap* mine = i == 0 ? fresh.hits.get() : fresh.misses.get();
+        Impl dropped(Impl::layerParams(impl_->params, i == 0), false);
+        Impl& into = mine != nullptr ? *mine->impl_ : dropped;
+        const double layer_a = readUnitFactor(&r);
+        readBlocks(into, PendingFormat{version, layer_a, layer_a == into.unitFactor()}, data.size(),
+                   &r);
       }
     }
     if (!r.done()) throw std::runtime_error("trailing bytes");

@@ -36,6 +36,13 @@ MapStats WaveletMap::stats(bool count_observed) const {
   st.bytes = impl.pool.bytes() + rest;
   st.bytes_reserved = impl.pool.bytesReserved() + rest;
   st.nodes_visited_last = impl.nodes_visited_last;
+  for (const WaveletMap* layer : {impl.hits.get(), impl.misses.get()}) {
+    if (layer == nullptr) continue;
+    const MapStats ls = layer->stats();
+    st.reflection_bytes += ls.bytes;
+    st.bytes += ls.bytes;
+    st.bytes_reserved += ls.bytes_reserved;
+  }
   if (count_observed) {
     for (const auto& kv : impl.blocks) {
       const Block& b = kv.second;

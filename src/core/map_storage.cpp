@@ -15,10 +15,11 @@ namespace {
 constexpr std::size_t kLentGroups = 64;
 }  // namespace
 
-WaveletMap::Impl::Impl(const MapParams& p) : params(p) {
-  throwIfInvalid(p);
+WaveletMap::Impl::Impl(const MapParams& p, bool validate) : params(p) {
+  if (validate) throwIfInvalid(p);
   levels = p.grid.block_levels;
   configure();
+  configureLayers();
 }
 
 void WaveletMap::Impl::configure() {
@@ -28,19 +29,23 @@ void WaveletMap::Impl::configure() {
   // tau = 0 still drops details below float round-off of the log-odds scale.
   constexpr double kRoundOff = 1e-6;
   prune_threshold = std::max(params.prune_threshold, kRoundOff);
-  // Section 6.5: all values stay in [odd_emp, odd_occ], so |d| <= 2R; once the pending
+  // Section 6.5: all values stay between odd_emp and odd_occ (R = |odd_occ - odd_emp|; a
+  // reflection layer's odd values are 0 and 1 either way round), so |d| <= 2R; once the pending
   // multiplier is below tau / 2R every detail of the subtree is below the pruning threshold and
   // the subtree can go.
-  const double halvings = std::log2(2.0 * (params.sensor.odd_occ - params.sensor.odd_emp) /
-                                    prune_threshold);
+  const double range = std::fabs(params.sensor.odd_occ - params.sensor.odd_emp);
+  const double halvings = std::max(0.0, std::log2(2.0 * range / prune_threshold));
   half_life = forget && params.policy.forget_half_life > 0.0;
   if (half_life) {
-    // The finest unit 2^-e for which the negligible multiplier still fits a 16-bit count.
-    constexpr double kMaxCount = 65535.0;
-    const int e = std::min(16, static_cast<int>(std::floor(std::log2(kMaxCount / halvings))));
+    // The finest unit 2^-e for which the negligible multiplier of the widest odd range (100:
+    // odd_occ <= 50, odd_emp >= -50) still fits a 16-bit count; it depends on tau only, so a
+    // map and its reflection layers share it (and so each scan's factor).
+    constexpr double kMaxCount = 65535.0, kWidestRange = 100.0;
+    const double widest = std::log2(2.0 * kWidestRange / prune_threshold);
+    const int e = std::min(16, static_cast<int>(std::floor(std::log2(kMaxCount / widest))));
     unit_log2 = std::ldexp(1.0, -e);
     k_cap = 65535;
-    k_star = static_cast<int>(std::ceil(halvings / unit_log2));
+    k_star = std::max(1, static_cast<int>(std::ceil(halvings / unit_log2)));
     for (std::size_t j = 0; j < mult_lo.size(); ++j) {
       mult_lo[j] = std::exp2(-static_cast<double>(j) * unit_log2);
       mult_hi[j] = std::exp2(-static_cast<double>(256 * j) * unit_log2);
@@ -58,8 +63,7 @@ void WaveletMap::Impl::configure() {
     if (a <= 0.0) {
       k_star = 1;
     } else if (a < 1.0) {
-      const double r = params.sensor.odd_occ - params.sensor.odd_emp;
-      const double k = std::ceil(std::log(prune_threshold / (2.0 * r)) / std::log(a));
+      const double k = std::ceil(std::log(prune_threshold / (2.0 * range)) / std::log(a));
       if (k < 255.0) k_star = std::max(1, static_cast<int>(k));
     }
   }

@@ -20,14 +20,15 @@ namespace detail {
 
 /// One quadtree node at level l >= 1: the three Haar details of its 2x2 children, its children
 /// (a group of 4 node slots in the pool; a missing child is a uniform block), the pending lazy
-/// forgetting (k units, see WaveletMap::Impl::multiplier) and what is known of its children. Level-1 nodes have finest cells as children.
-/// A trivial type: `Node{}` is the empty node (all zero); `Node n;` is uninitialised, so that the
-/// pool's chunks need not be cleared (allocate() clears each group it hands out).
+/// forgetting (k units, see WaveletMap::Impl::multiplier) and what is known of its children.
+/// Level-1 nodes have finest cells as children. A trivial type: `Node{}` is the empty node (all
+/// zero); `Node n;` is uninitialised, so that the pool's chunks need not be cleared (allocate()
+/// clears each group it hands out).
 struct Node {
-  float d[3];              ///< stored details dx, dy, dxy (true = stored * multiplier(k's))
-  std::uint32_t children;  ///< pool group of the 4 child slots; 0 = no child node
-  std::uint16_t k;         ///< pending forgetting units for this node and its subtree
-  std::uint8_t child_mask;    ///< bit q: child node q exists in the group
+  float d[3];                  ///< stored details dx, dy, dxy (true = stored * multiplier(k's))
+  std::uint32_t children;      ///< pool group of the 4 child slots; 0 = no child node
+  std::uint16_t k;             ///< pending forgetting units for this node and its subtree
+  std::uint8_t child_mask;     ///< bit q: child node q exists in the group
   std::uint8_t known_all : 4;  ///< bit q: every finest cell of child q was observed
   std::uint8_t known_any : 4;  ///< bit q: some finest cell of child q was observed
 };

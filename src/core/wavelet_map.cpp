@@ -15,6 +15,8 @@ using detail::Block;
 using detail::Node;
 
 WaveletMap::WaveletMap(const MapParams& params) : impl_(std::make_unique<Impl>(params)) {}
+WaveletMap::WaveletMap(const MapParams& params, LayerTag)
+    : impl_(std::make_unique<Impl>(params, false)) {}
 WaveletMap::~WaveletMap() = default;
 WaveletMap::WaveletMap(WaveletMap&&) noexcept = default;
 WaveletMap& WaveletMap::operator=(WaveletMap&&) noexcept = default;
@@ -74,6 +76,9 @@ void WaveletMap::reset() {
   impl_->blocks.clear();
   impl_->pool.clear();
   impl_->nodes = 0;
+  for (WaveletMap* layer : {impl_->hits.get(), impl_->misses.get()}) {
+    if (layer != nullptr) layer->reset();
+  }
 }
 
 void WaveletMap::setPolicy(const PolicyParams& policy, const SensorModelParams& sensor) {
@@ -85,6 +90,7 @@ void WaveletMap::setPolicy(const PolicyParams& policy, const SensorModelParams& 
   const double old_init = impl_->init;
   impl_->params = p;
   impl_->configure();
+  impl_->configureLayers();
   // Never-observed space follows the new prior: uniform unobserved blocks are the only place it
   // is stored without a cell of its own (missing blocks read as the prior already).
   if (impl_->init != old_init) {

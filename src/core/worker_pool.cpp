@@ -12,8 +12,8 @@ namespace {
 // Polls ready() for at most WorkerPool::kSpinMicroseconds; true as soon as it holds.
 template <typename Ready>
 bool spinUntil(Ready ready) {
-  const auto until = std::chrono::steady_clock::now() +
-                     std::chrono::microseconds(WorkerPool::kSpinMicroseconds);
+  const auto until =
+      std::chrono::steady_clock::now() + std::chrono::microseconds(WorkerPool::kSpinMicroseconds);
   for (;;) {
     for (int i = 0; i < 64; ++i) {
       if (ready()) return true;

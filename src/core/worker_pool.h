@@ -39,8 +39,8 @@ class WorkerPool {
 
   std::vector<std::thread> workers_;
   std::mutex mu_;
-  std::condition_variable start_;  // a new job, or stop
-  std::condition_variable done_;   // the last worker finished the job
+  std::condition_variable start_;                  // a new job, or stop
+  std::condition_variable done_;                   // the last worker finished the job
   const std::function<void(int)>* job_ = nullptr;  // set before generation_ is released
   std::atomic<std::uint64_t> generation_{0};       // jobs started so far
   std::atomic<int> running_{0};                    // workers still in the current job

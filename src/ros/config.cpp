@@ -139,6 +139,7 @@ const std::vector<KeyReader>& readers() {
       {"lazy_forgetting",
        [](auto& k, auto& v, Config* c) { c->map.lazy_forgetting = asBool(k, v); }},
       {"num_threads", [](auto& k, auto& v, Config* c) { c->map.num_threads = asInt(k, v); }},
+      {"reflection", [](auto& k, auto& v, Config* c) { c->map.reflection = asBool(k, v); }},
       // ---- ROS
       {"map_frame", [](auto& k, auto& v, Config* c) { c->ros.map_frame = asString(k, v); }},
       {"base_frame", [](auto& k, auto& v, Config* c) { c->ros.base_frame = asString(k, v); }},

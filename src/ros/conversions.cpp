@@ -167,8 +167,11 @@ LayerSize layerBox(const wavog::WaveletMap& map, int scale, double window, doubl
   return cells(b) > kMaxLayerCells ? LayerSize::kTooLarge : LayerSize::kOk;
 }
 
-nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
-                                                const std::string& frame, const ros::Time& stamp) {
+namespace {
+// The grid message of a raster of either kind (the cells filled by the caller).
+template <typename R>
+nav_msgs::OccupancyGrid::Ptr gridMsg(const R& raster, const std::string& frame,
+                                     const ros::Time& stamp) {
   auto msg = boost::make_shared<nav_msgs::OccupancyGrid>();
   msg->header.frame_id = frame;
   msg->header.stamp = stamp;
@@ -181,6 +184,17 @@ nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
   msg->info.origin.orientation.w = 1.0;
   msg->data = wavog::toOccupancyGrid(raster);
   return msg;
+}
+}  // namespace
+
+nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
+                                                const std::string& frame, const ros::Time& stamp) {
+  return gridMsg(raster, frame, stamp);
+}
+
+nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::ReflectionRaster& raster,
+                                                const std::string& frame, const ros::Time& stamp) {
+  return gridMsg(raster, frame, stamp);
 }
 
 map_msgs::OccupancyGridUpdate::Ptr toOccupancyGridUpdateMsg(const wavog::Raster& raster,

@@ -41,21 +41,37 @@ void DirtyRegion::add(const MapBox& b) {
   box.max_y = std::max(box.max_y, b.max_y);
 }
 
-MapPublisher::MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales) : nh_(nh) {
+MapPublisher::MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales,
+                           bool reflection)
+    : nh_(nh), reflection_(reflection) {
   map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
   update_pub_ = nh_.advertise<map_msgs::OccupancyGridUpdate>("map_updates", 10);
+  if (reflection_) reflection_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("reflection", 1, true);
   advertiseScales(scales);
 }
 
-void MapPublisher::advertiseScales(const std::vector<int>& scales) {
+namespace {
+// Publishers of `prefix`<s> for exactly `scales`, keeping those of `old` that stay.
+std::map<int, ros::Publisher> scalePublishers(ros::NodeHandle& nh, const std::string& prefix,
+                                              const std::vector<int>& scales,
+                                              const std::map<int, ros::Publisher>& old) {
   std::map<int, ros::Publisher> pubs;
   for (int s : scales) {
-    auto it = scale_pubs_.find(s);
-    pubs[s] = it != scale_pubs_.end()
+    auto it = old.find(s);
+    pubs[s] = it != old.end()
                   ? it->second
-                  : nh_.advertise<nav_msgs::OccupancyGrid>("map_scale_" + std::to_string(s), 1);
+                  : nh.advertise<nav_msgs::OccupancyGrid>(prefix + std::to_string(s), 1);
   }
-  scale_pubs_.swap(pubs);
+  return pubs;
+}
+}  // namespace
+
+void MapPublisher::advertiseScales(const std::vector<int>& scales) {
+  scale_pubs_ = scalePublishers(nh_, "map_scale_", scales, scale_pubs_);
+  if (reflection_) {
+    reflection_scale_pubs_ =
+        scalePublishers(nh_, "reflection_scale_", scales, reflection_scale_pubs_);
+  }
 }
 
 std::vector<int> MapPublisher::scales() const {
@@ -74,10 +90,18 @@ void MapPublisher::markAllDirty(double resolution) {
 Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params, double cx,
                           double cy) {
   Layers out;
-  // `map` is latched: always published. A scale layer nobody listens to costs nothing.
-  out.layers.push_back({0, map_pub_, {}});
+  // `map` and `reflection` are latched: always published. A scale layer nobody listens to costs
+  // nothing; a reflection scale layer reads its occupancy layer for the box, publishing it only
+  // when that has listeners too.
+  out.layers.push_back({0, map_pub_, reflection_pub_, {}, {}});
   for (const auto& sp : scale_pubs_) {
-    if (sp.second.getNumSubscribers() > 0) out.layers.push_back({sp.first, sp.second, {}});
+    const auto rp = reflection_scale_pubs_.find(sp.first);
+    const ros::Publisher reflection =
+        rp != reflection_scale_pubs_.end() && rp->second.getNumSubscribers() > 0 ? rp->second
+                                                                                 : ros::Publisher();
+    const ros::Publisher occupancy =
+        sp.second.getNumSubscribers() > 0 ? sp.second : ros::Publisher();
+    if (occupancy || reflection) out.layers.push_back({sp.first, occupancy, reflection, {}, {}});
   }
   for (Layers::Layer& layer : out.layers) {
     // With a window, the read-out costs what the window holds, never the whole map.
@@ -98,6 +122,10 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
       wavog::Raster r = map.exportScale(layer.scale, box, aggregation);
       if (wavog::knownBox(r, &known)) layer.raster = wavog::cropToKnown(r, 0);
     }
+    if (layer.reflection_pub) {
+      layer.reflection = map.exportReflection(layer.scale, layer.raster.box);
+      layer.reflection.cell_size = layer.raster.cell_size;  // also for an empty box
+    }
     if (layer.scale == 0) {
       // The dirty region is reset by map_updates only: re-sending an area the full map already
       // carries is harmless, while two timers of the same period would otherwise starve updates.
@@ -108,10 +136,12 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
   return out;
 }
 
-void MapPublisher::publish(const Layers& layers, const std::string& frame,
-                           const ros::Time& stamp) {
+void MapPublisher::publish(const Layers& layers, const std::string& frame, const ros::Time& stamp) {
   for (const Layers::Layer& layer : layers.layers) {
-    layer.pub.publish(toOccupancyGridMsg(layer.raster, frame, stamp));
+    if (layer.pub) layer.pub.publish(toOccupancyGridMsg(layer.raster, frame, stamp));
+    if (layer.reflection_pub) {
+      layer.reflection_pub.publish(toOccupancyGridMsg(layer.reflection, frame, stamp));
+    }
   }
 }
 

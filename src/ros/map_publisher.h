@@ -1,7 +1,8 @@
 // Publication of the map: the `map` layer (latched) and the map_scale_<s> layers, cut to a window
-// around the robot or the whole map; map_updates, the changed rectangle of the finest layer, from
-// one dirty region. Reads happen under the caller's lock (MappingRos::Impl::mutex_, which guards
-// this object and the map); publish() and publishUpdate() run without it.
+// around the robot or the whole map, and with MapParams::reflection the `reflection` (latched) and
+// reflection_scale_<s> layers over the same boxes; map_updates, the changed rectangle of the finest
+// layer, from one dirty region. Reads happen under the caller's lock (MappingRos::Impl::mutex_,
+// which guards this object and the map); publish() and publishUpdate() run without it.
 #ifndef WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
 #define WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
 
@@ -33,8 +34,10 @@ struct DirtyRegion {
 struct Layers {
   struct Layer {
     int scale;
-    ros::Publisher pub;
+    ros::Publisher pub;             ///< occupancy; null when only its reflection is wanted
+    ros::Publisher reflection_pub;  ///< null when its reflection is not wanted
     wavog::Raster raster;
+    wavog::ReflectionRaster reflection;  ///< over raster's box
   };
   std::vector<Layer> layers;
   std::vector<std::string> refused;  ///< one line per layer larger than kMaxLayerCells
@@ -42,8 +45,9 @@ struct Layers {
 
 class MapPublisher {
  public:
-  /// Advertises map, map_updates and map_scale_<s> for `scales` on `nh`.
-  MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales);
+  /// Advertises map, map_updates and map_scale_<s> for `scales` on `nh`; with `reflection`, also
+  /// reflection and reflection_scale_<s>.
+  MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales, bool reflection);
 
   /// Publishes map_scale_<s> for exactly `scales` (publishers of kept scales are kept).
   void advertiseScales(const std::vector<int>& scales);
@@ -74,6 +78,9 @@ class MapPublisher {
   ros::NodeHandle nh_;
   ros::Publisher map_pub_, update_pub_;
   std::map<int, ros::Publisher> scale_pubs_;
+  bool reflection_ = false;
+  ros::Publisher reflection_pub_;
+  std::map<int, ros::Publisher> reflection_scale_pubs_;
   DirtyRegion dirty_;
   bool have_full_ = false;
   wavog::CellBox last_full_box_;  ///< scale-0 box of the last full `map`

@@ -176,6 +176,17 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
     const float v = map.value(c);
     return e.type == WorldEvent::Type::kDeparture ? v < -kDecisionMargin : v > kDecisionMargin;
   };
+  auto mean_reflection = [&map](const WorldEvent& e) {
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (const CellIndex& c : e.cells) {
+      const float p = map.reflection(c);
+      if (std::isnan(p)) continue;
+      sum += p;
+      ++n;
+    }
+    return n > 0 ? sum / static_cast<double>(n) : std::numeric_limits<double>::quiet_NaN();
+  };
   auto mean_occupancy = [&map](const WorldEvent& e) {
     double sum = 0.0;
     for (const CellIndex& c : e.cells) sum += probability(map.value(c));
@@ -213,6 +224,7 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
       while (s.stamp >= next_sample[k]) {
         r.times.push_back(next_sample[k]);
         r.mean_occupancy.push_back(mean_occupancy(e));
+        if (run.params.reflection) r.mean_reflection.push_back(mean_reflection(e));
         next_sample[k] += options.sample_period;
       }
     }

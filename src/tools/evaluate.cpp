@@ -46,6 +46,7 @@ struct Options {
   std::string offline_summary;        // JSON file embedded as "offline_map" in summary.json
   std::string core_maps;              // also map with the default forgetting config, PNGs here
   std::string pose_noise = "0:0,2:0.2,5:0.5";  // noise study levels (cm:deg); "none": skip
+  bool reflection = false;                      // every run also keeps the reflection map
 };
 
 /// What --help says first.
@@ -69,6 +70,9 @@ void addOptions(CLI::App* app, Options* o) {
       ->type_name("NAME");
   wavog_tools::addInteger(app, "--jobs", &o->jobs, 1,
                           "policies evaluated in parallel (1 for clean timings)");
+  app->add_flag("--reflection", o->reflection,
+                "every run also keeps the reflection map; the cars' mean reflection p goes into "
+                "figure_data/responses.csv (plot_evaluation.py draws reflection_*.png)");
   app->add_option("--offline-summary", o->offline_summary,
                   "embed this JSON (wavog_offline's summary) in summary.json");
   app->add_option("--core-maps", o->core_maps,
@@ -192,6 +196,7 @@ int run(const Options& o) {
     for (const std::string& p : o.policies) keep = keep || r.label.rfind(p, 0) == 0;
     if (keep) runs.push_back(r);
   }
+  for (PolicyRun& r : runs) r.params.reflection = o.reflection;
   if (runs.empty()) throw std::invalid_argument("no policy matches --policy");
   EvaluationOptions eo;
   eo.fraction = o.fraction;

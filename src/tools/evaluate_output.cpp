@@ -221,12 +221,15 @@ void writeFigureData(const std::string& dir, const World& world,
   }
   wavog_tools::writeJson((data / "figures.json").string(), fig);
   std::ofstream csv(data / "responses.csv");
-  csv << "event,policy,time_s,mean_p_occ\n" << std::setprecision(6);
+  // mean_reflection_p: empty without --reflection, "nan" while no cell of the car has a p.
+  csv << "event,policy,time_s,mean_p_occ,mean_reflection_p\n" << std::setprecision(6);
   for (std::size_t k = 0; k < events.size(); ++k) {
     for (const PolicyResult& r : results) {
       const EventResponse& e = r.events[k];
       for (std::size_t j = 0; j < e.times.size(); ++j) {
-        csv << k << "," << r.label << "," << e.times[j] << "," << e.mean_occupancy[j] << "\n";
+        csv << k << "," << r.label << "," << e.times[j] << "," << e.mean_occupancy[j] << ",";
+        if (j < e.mean_reflection.size()) csv << e.mean_reflection[j];
+        csv << "\n";
       }
     }
   }

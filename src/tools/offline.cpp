@@ -97,6 +97,9 @@ void addOptions(CLI::App* app, Options* o) {
                           "threads updating one scan's blocks (num_threads; 0: one per core; the "
                           "map is the same for every N)")
       ->default_str("the YAML's");
+  app->add_flag("--reflection", o->reflection,
+                "also keep the reflection probability map (reflection: true) and write "
+                "reflection_s<scale>.png / .pgm / .yaml");
   app->add_flag_callback(
       "--no-progress", [o] { o->progress = false; }, "no progress bar");
   app->add_flag_callback(
@@ -133,6 +136,7 @@ wavog_ros::Config loadConfig(const Options& o, std::vector<std::string>* unknown
   if (!o.policy.empty()) root["policy"] = o.policy;
   if (o.resolution > 0.0) root["resolution"] = o.resolution;
   if (o.threads >= 0) root["num_threads"] = o.threads;
+  if (o.reflection) root["reflection"] = true;
   if (!o.aggregation.empty()) root["scale_aggregation"] = o.aggregation;
   try {
     return wavog_ros::configFromXmlRpc(root, unknown);
@@ -142,8 +146,25 @@ wavog_ros::Config loadConfig(const Options& o, std::vector<std::string>* unknown
   }
 }
 
-/// Per scale: a PNG and a map_server map, cropped to the observed part; their entries of
-/// summary.json's "scales".
+/// Reflection probabilities as a raster of log-odds logit(p) (known where p is a number), so that
+/// the occupancy map's pictures and map_server files show p as they show P(occupied).
+wavog::Raster reflectionAsRaster(const wavog::ReflectionRaster& r) {
+  wavog::Raster out;
+  out.scale = r.scale;
+  out.cell_size = r.cell_size;
+  out.box = r.box;
+  out.log_odds.resize(r.p.size());
+  out.known.resize(r.p.size());
+  for (std::size_t i = 0; i < r.p.size(); ++i) {
+    const double p = std::clamp(static_cast<double>(r.p[i]), 1e-6, 1.0 - 1e-6);
+    out.known[i] = std::isnan(r.p[i]) ? 0 : 1;
+    out.log_odds[i] = std::isnan(r.p[i]) ? 0.0f : static_cast<float>(std::log(p / (1.0 - p)));
+  }
+  return out;
+}
+
+/// Per scale: a PNG and a map_server map, cropped to the observed part (and the same of the
+/// reflection map, when kept); their entries of summary.json's "scales".
 Json writeScales(const Options& o, const wavog_ros::Config& config, Session* session) {
   Json scales = Json::array();
   wavog::WaveletMap* map = &session->map();
@@ -155,14 +176,30 @@ Json writeScales(const Options& o, const wavog_ros::Config& config, Session* ses
     const std::string base = wavog::scaleFileBase("map", scale);  // as ~save_map names them
     wavog::writePng((fs::path(o.out) / (base + ".png")).string(), wavog::renderRgb(raster));
     wavog::writeMapServerMap((fs::path(o.out) / base).string(), raster);
-    scales.push_back({{"scale", scale},
-                      {"cell_size_m", raster.cell_size},
-                      {"width", raster.box.width()},
-                      {"height", raster.box.height()},
-                      {"origin", {raster.originX(), raster.originY()}},
-                      {"png", base + ".png"},
-                      {"pgm", base + ".pgm"},
-                      {"yaml", base + ".yaml"}});
+    Json entry = {{"scale", scale},
+                  {"cell_size_m", raster.cell_size},
+                  {"width", raster.box.width()},
+                  {"height", raster.box.height()},
+                  {"origin", {raster.originX(), raster.originY()}},
+                  {"png", base + ".png"},
+                  {"pgm", base + ".pgm"},
+                  {"yaml", base + ".yaml"}};
+    if (config.map.reflection) {
+      // Over the occupancy layer's box, drawn like it (p as the grey level, unknown pale blue).
+      const wavog::Raster reflection = reflectionAsRaster(map->exportReflection(scale, raster.box));
+      const std::string rbase = wavog::scaleFileBase("reflection", scale);
+      wavog::writePng((fs::path(o.out) / (rbase + ".png")).string(), wavog::renderRgb(reflection));
+      wavog::writeMapServerMap((fs::path(o.out) / rbase).string(), reflection);
+      std::size_t reflecting = 0;  // cells with p >= 0.5
+      for (std::size_t i = 0; i < reflection.known.size(); ++i) {
+        reflecting += reflection.known[i] != 0 && reflection.log_odds[i] >= 0.0f;
+      }
+      entry["reflection"] = {{"png", rbase + ".png"},
+                             {"pgm", rbase + ".pgm"},
+                             {"yaml", rbase + ".yaml"},
+                             {"cells_p_at_least_half", reflecting}};
+    }
+    scales.push_back(entry);
   }
   return scales;
 }

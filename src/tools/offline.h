@@ -38,6 +38,7 @@ struct Options {
   bool progress = true;
   bool quiet = false;
   int threads = -1;  // -1: the YAML's num_threads
+  bool reflection = false;  // --reflection (else the YAML's)
 };
 
 /// Counts, snapshots and progress around WaveletMap::integrate, shared by both inputs.

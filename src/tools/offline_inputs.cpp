@@ -138,7 +138,7 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   std::string first_tf_error;
   std::set<std::string> scan_frames;
   std::map<std::string, wavog::ScanPeriod> periods;  // per topic, for forget_half_life
-  std::set<std::string> slash_warned;  // topics whose frame_id had a leading '/'
+  std::set<std::string> slash_warned;                // topics whose frame_id had a leading '/'
   wavog::MotionCompensator compensator;
   wavog_ros::PlacementOptions placement_options;
   placement_options.fixed_frame = info.fixed_frame;

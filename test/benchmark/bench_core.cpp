@@ -79,14 +79,23 @@ const std::vector<Scan>& workload(const std::string& name) {
   return cache[name] = std::move(scans);
 }
 
-enum Variant { kClamp = 0, kForgetLazy = 1, kForgetEager = 2 };
-const char* kVariantNames[] = {"clamp", "forget_lazy", "forget_eager"};
+enum Variant {
+  kClamp = 0,
+  kForgetLazy = 1,
+  kForgetEager = 2,
+  kClampReflection = 3,  // with the reflection layers (MapParams::reflection)
+  kForgetReflection = 4,
+};
+const char* kVariantNames[] = {"clamp", "forget_lazy", "forget_eager", "clamp+reflection",
+                               "forget_lazy+reflection"};
 
 MapParams paramsFor(Variant v, double res, double tau) {
-  MapParams p = MapParams::defaultsFor(v == kClamp ? PolicyType::kClamp : PolicyType::kForget);
+  const bool clamp = v == kClamp || v == kClampReflection;
+  MapParams p = MapParams::defaultsFor(clamp ? PolicyType::kClamp : PolicyType::kForget);
   p.grid.resolution = res;
   p.lazy_forgetting = v != kForgetEager;
   p.prune_threshold = tau;
+  p.reflection = v == kClampReflection || v == kForgetReflection;
   return p;
 }
 
@@ -215,6 +224,14 @@ void printSummary() {
                   m(base + "clamp") / m(base + "forget_lazy"));
       std::printf("%-20s lazy / eager speed           = %.2f (target >= 3 on 80 m)\n", (std::string(wl) + "@" + res).c_str(),
                   m(base + "forget_lazy") / m(base + "forget_eager"));
+      for (const char* v : {"clamp", "forget_lazy"}) {
+        const std::string with = base + v + "+reflection";
+        if (!g_rates.count(with)) continue;
+        std::printf("%-20s %-11s reflection cost / occupancy alone = %.2f (target <= 1.3), bytes/cell "
+                    "%.3f -> %.3f\n",
+                    (std::string(wl) + "@" + res).c_str(), v, m(base + v) / m(with),
+                    g_figures[base + v].bytes_per_cell, g_figures[with].bytes_per_cell);
+      }
     }
   }
   if (g_rates.count("synthetic80m@5cm/forget_lazy")) {
@@ -268,7 +285,8 @@ void printSummary() {
 int main(int argc, char** argv) {
   for (const char* wl : {"fr079", "synthetic80m"}) {
     for (double res : {0.05, 0.10}) {
-      for (Variant v : {kClamp, kForgetLazy, kForgetEager}) {
+      for (Variant v : {kClamp, kForgetLazy, kForgetEager, kClampReflection, kForgetReflection}) {
+        if (res != 0.05 && (v == kClampReflection || v == kForgetReflection)) continue;
         const std::string name = std::string("integrate/") + wl + "/" +
                                  std::to_string(static_cast<int>(std::lround(res * 100))) + "cm/" + kVariantNames[v];
         benchmark::RegisterBenchmark(name.c_str(), BM_Integrate, std::string(wl), res, v)

@@ -287,8 +287,8 @@ class FifoWriter {
 TEST(CarmenReader, ReadsPlainAndGzipLogsFromAFifoWithoutLosingBytes) {
   TempDir tmp;
   // The first bytes are those a magic-number probe would have taken from the stream.
-  const std::string log = flaser(181, "2.5", 10.0) + "\n" + robotLaser(11.0) + "\n" +
-                          flaser(90, "1.5", 12.0) + "\n";
+  const std::string log =
+      flaser(181, "2.5", 10.0) + "\n" + robotLaser(11.0) + "\n" + flaser(90, "1.5", 12.0) + "\n";
   for (const bool gz : {false, true}) {
     SCOPED_TRACE(gz ? "gzip" : "plain");
     const std::string path = tmp.path(gz ? "fifo_gz" : "fifo_plain");

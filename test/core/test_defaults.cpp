@@ -47,7 +47,8 @@ std::map<std::string, std::string> coreDefaults() {
           {"prune_threshold", num(d.prune_threshold)},
           {"skip_tolerance", num(d.skip_tolerance)},
           {"lazy_forgetting", d.lazy_forgetting ? "true" : "false"},
-          {"num_threads", num(d.num_threads)}};
+          {"num_threads", num(d.num_threads)},
+          {"reflection", d.reflection ? "true" : "false"}};
 }
 
 // A number as written in a file, normalised like num() above ("0.0" -> "0", "-2.0" -> "-2").

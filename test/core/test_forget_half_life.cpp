@@ -4,19 +4,18 @@
 // with a different gamma per scan; lasers of different rates forget at the same rate per second;
 // files keep the units, and files of format version 1 still load.
 #include <gtest/gtest.h>
-
-#include <cmath>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "dense_reference.h"
-#include "wavog_mapping/core/scan_period.h"
 #include "test_support.h"
+#include "wavog_mapping/core/scan_period.h"
 
 namespace wavog_test {
 namespace {
@@ -99,8 +98,8 @@ TEST(ForgetHalfLife, LazyTreeEqualsReferenceWithAGammaPerScan) {
     eager.integrate(s.pose, v);
     if (i % 25 == 24) {
       const Comparison c = compare(lazy, ref);
-      EXPECT_LE(c.max_rel_error, kTolerance) << "scan " << i << " at " << c.worst_x << ", "
-                                             << c.worst_y;
+      EXPECT_LE(c.max_rel_error, kTolerance)
+          << "scan " << i << " at " << c.worst_x << ", " << c.worst_y;
       EXPECT_EQ(c.knowledge_mismatches, 0u);
       EXPECT_LE(compare(eager, ref).max_rel_error, kTolerance) << "scan " << i;
     }
@@ -220,15 +219,15 @@ TEST(ForgetHalfLife, FilesOfFormatVersion1StillLoad) {
 TEST(ScanPeriod, StampDifferencesThenTheDriversScanTimeThenUnknown) {
   constexpr double kEps = 1e-9;
   wavog::ScanPeriod period;
-  EXPECT_EQ(period.next(100.0), 0.0);                      // the first scan: unknown
-  EXPECT_NEAR(period.next(100.025, 0.5), 0.025, kEps);     // stamps first
-  EXPECT_NEAR(period.next(100.125, 0.025), 0.1, kEps);     // a dropped scan is time that passed
-  EXPECT_EQ(period.next(105.0, 0.025), 0.025);             // a gap over kMaxPeriod: scan_time
-  EXPECT_EQ(period.next(110.0), 0.0);                      // a gap, no scan_time: unknown
-  EXPECT_EQ(period.next(109.0), 0.0);                      // backwards: unknown
-  EXPECT_NEAR(period.next(109.04), 0.04, kEps);            // on from the backward stamp
-  EXPECT_EQ(period.next(std::nan(""), 0.0), 0.0);          // a non-finite stamp
-  EXPECT_EQ(period.next(109.1, 5.0), 0.0);                 // after it; scan_time too long
+  EXPECT_EQ(period.next(100.0), 0.0);                   // the first scan: unknown
+  EXPECT_NEAR(period.next(100.025, 0.5), 0.025, kEps);  // stamps first
+  EXPECT_NEAR(period.next(100.125, 0.025), 0.1, kEps);  // a dropped scan is time that passed
+  EXPECT_EQ(period.next(105.0, 0.025), 0.025);          // a gap over kMaxPeriod: scan_time
+  EXPECT_EQ(period.next(110.0), 0.0);                   // a gap, no scan_time: unknown
+  EXPECT_EQ(period.next(109.0), 0.0);                   // backwards: unknown
+  EXPECT_NEAR(period.next(109.04), 0.04, kEps);         // on from the backward stamp
+  EXPECT_EQ(period.next(std::nan(""), 0.0), 0.0);       // a non-finite stamp
+  EXPECT_EQ(period.next(109.1, 5.0), 0.0);              // after it; scan_time too long
   EXPECT_NEAR(period.next(109.2), 0.1, kEps);
 }
 

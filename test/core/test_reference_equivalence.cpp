@@ -8,7 +8,6 @@
 
 #include "dense_reference.h"
 #include "test_support.h"
-#include "wavog_mapping/io/carmen_reader.h"
 
 namespace wavog_test {
 namespace {
@@ -183,24 +182,20 @@ TEST(ReferenceEquivalence, SectorBoundariesThroughCellCentres) {
 
 // (b) The first 500 scans of the Freiburg fr079 log.
 TEST(ReferenceEquivalence, Fr079First500Scans) {
-  const std::string dir = dataDir();
-  ASSERT_FALSE(dir.empty());
-  const auto log = wavog::readCarmenLog(dir + "/fr079-corrected.log.gz", 500);
+  const std::vector<OwnedScan> log = fr079Scans(500);
   ASSERT_EQ(log.size(), 500u);
   const double res = 0.1;
   // Extent: every endpoint and pose, with a margin.
   double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
-  for (const auto& s : log) {
-    const auto v = s.view();
-    for (std::size_t j = 0; j < v.count; ++j) {
-      const double z = v.ranges[j];
-      if (!std::isfinite(z) || z >= v.range_max) continue;
-      const double b =
-          s.laser_pose.theta + v.angle_min + static_cast<double>(j) * v.angle_increment;
-      x0 = std::min(x0, s.laser_pose.x + z * std::cos(b));
-      x1 = std::max(x1, s.laser_pose.x + z * std::cos(b));
-      y0 = std::min(y0, s.laser_pose.y + z * std::sin(b));
-      y1 = std::max(y1, s.laser_pose.y + z * std::sin(b));
+  for (const OwnedScan& s : log) {
+    for (std::size_t j = 0; j < s.ranges.size(); ++j) {
+      const double z = s.ranges[j];
+      if (!std::isfinite(z) || z >= s.range_max) continue;
+      const double b = s.pose.theta + s.angle_min + static_cast<double>(j) * s.angle_increment;
+      x0 = std::min(x0, s.pose.x + z * std::cos(b));
+      x1 = std::max(x1, s.pose.x + z * std::cos(b));
+      y0 = std::min(y0, s.pose.y + z * std::sin(b));
+      y1 = std::max(y1, s.pose.y + z * std::sin(b));
     }
   }
   const CellBox extent{static_cast<std::int64_t>(std::floor(x0 / res)) - 4,
@@ -208,17 +203,7 @@ TEST(ReferenceEquivalence, Fr079First500Scans) {
                        static_cast<std::int64_t>(std::floor(x1 / res)) + 5,
                        static_cast<std::int64_t>(std::floor(y1 / res)) + 5};
   PolicyRun run(everyPolicy(res, 6), extent);
-  for (const auto& s : log) {
-    OwnedScan o;
-    o.pose = s.laser_pose;
-    const auto v = s.view();
-    o.ranges.assign(v.ranges, v.ranges + v.count);
-    o.angle_min = v.angle_min;
-    o.angle_increment = v.angle_increment;
-    o.range_min = v.range_min;
-    o.range_max = v.range_max;
-    run.integrate(o);
-  }
+  for (const OwnedScan& s : log) run.integrate(s);
   run.expectEqual("fr079 500 scans");
   run.expectMultiscale(4);
 }

@@ -7,6 +7,9 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <utility>
+
+#include "wavog_mapping/io/carmen_reader.h"
 
 namespace wavog_test {
 
@@ -93,6 +96,24 @@ Comparison compare(const wavog::WaveletMap& map, const DenseReference& ref) {
     }
   }
   return c;
+}
+
+std::vector<OwnedScan> fr079Scans(std::size_t n) {
+  std::vector<OwnedScan> out;
+  const std::string dir = dataDir();
+  if (dir.empty()) return out;
+  for (const auto& s : wavog::readCarmenLog(dir + "/fr079-corrected.log.gz", n)) {
+    OwnedScan o;
+    o.pose = s.laser_pose;
+    const auto v = s.view();
+    o.ranges.assign(v.ranges, v.ranges + v.count);
+    o.angle_min = v.angle_min;
+    o.angle_increment = v.angle_increment;
+    o.range_min = v.range_min;
+    o.range_max = v.range_max;
+    out.push_back(std::move(o));
+  }
+  return out;
 }
 
 std::string dataDir() {

@@ -54,6 +54,10 @@ Comparison compare(const wavog::WaveletMap& map, const DenseReference& ref);
 /// Directory of ../shared/data (or $WAVOG_DATA_DIR); fails the test when missing.
 std::string dataDir();
 
+/// The first `n` scans of fr079-corrected.log.gz as scans with their own storage, each placed at
+/// its logged laser pose (empty, and the test failed, when the data set is missing).
+std::vector<OwnedScan> fr079Scans(std::size_t n);
+
 }  // namespace wavog_test
 
 #endif  // WAVOG_MAPPING_TEST_CORE_TEST_SUPPORT_H_

@@ -38,9 +38,10 @@ constexpr int kOracleMaxScale = 3;  // coarse scales compared with the reference
 struct Scan {
   Pose2 pose;
   std::vector<float> ranges;
-  double angle_min = 0, angle_increment = 0, range_min = 0, range_max = 0;
+  double angle_min = 0, angle_increment = 0, range_min = 0, range_max = 0, period = 0;
   ScanView view() const {
-    return ScanView{ranges.data(), ranges.size(), angle_min, angle_increment, range_min, range_max};
+    return ScanView{ranges.data(), ranges.size(), angle_min, angle_increment,
+                    range_min,     range_max,     period};
   }
 };
 
@@ -63,6 +64,7 @@ MapParams decodeParams(FuzzedDataProvider* in, bool oracle) {
   MapParams p = MapParams::defaultsFor(type);
   p.policy.init = in->ConsumeBool() ? wavog::InitValue::kEmptyBound : wavog::InitValue::kUnknown;
   p.lazy_forgetting = in->ConsumeBool();
+  p.reflection = in->ConsumeBool();
   if (oracle) {
     p.grid.resolution = pick(in, {0.05, 0.1, 0.2, 0.15});
     p.grid.block_levels = in->ConsumeIntegralInRange<int>(2, 5);
@@ -96,6 +98,7 @@ MapParams decodeParams(FuzzedDataProvider* in, bool oracle) {
   p.policy.clamp_max = maybe(p.policy.clamp_max, 0.0, 10.0);
   p.prune_threshold = maybe(p.prune_threshold, 0.0, 1.0);
   p.skip_tolerance = maybe(p.skip_tolerance, 0.0, 1.0);
+  p.policy.forget_half_life = in->ConsumeBool() ? 0.0 : maybe(0.3, 0.0, 1e6);
   return p;
 }
 
@@ -119,6 +122,7 @@ Scan decodeScan(FuzzedDataProvider* in, bool oracle) {
     s.angle_increment = hostileDouble(in, -0.1, 0.1);
     s.range_min = hostileDouble(in, 0.0, 1.0);
     s.range_max = hostileDouble(in, 0.0, 100.0);
+    s.period = hostileDouble(in, 0.0, 2.0);
   }
   s.ranges.resize(n);
   const auto hi = static_cast<float>(oracle ? 4.0 : 120.0);

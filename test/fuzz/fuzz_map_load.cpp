@@ -61,9 +61,9 @@ MapParams paramsFor(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   const std::uint8_t mode = data[0];
-  const std::vector<std::uint8_t> file =
-      (mode & 1) ? frame(data + 1, size - 1, (mode & 8) ? 1 : 2)
-                 : std::vector<std::uint8_t>(data + 1, data + size);
+  const std::vector<std::uint8_t> file = (mode & 1)
+                                             ? frame(data + 1, size - 1, (mode & 8) ? 1 : 2)
+                                             : std::vector<std::uint8_t>(data + 1, data + size);
   const MapParams params = paramsFor(file, mode);
   static const std::string path = wavog_fuzz::scratchPath("load.wavog");
   static const std::string again_path = wavog_fuzz::scratchPath("again.wavog");

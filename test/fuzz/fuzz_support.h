@@ -121,6 +121,17 @@ inline std::vector<wavog::Raster> readOutEveryScale(const wavog::WaveletMap& map
       }
       out.push_back(std::move(r));
     }
+    if (map.params().reflection) {
+      const wavog::ReflectionRaster r = map.exportReflection(s, box);
+      const auto grid = wavog::toOccupancyGrid(r);
+      WAVOG_FUZZ_CHECK(grid.size() == r.p.size(), "reflection: %zu values for %zu cells",
+                       grid.size(), r.p.size());
+      for (std::size_t i = 0; i < grid.size(); ++i) {
+        WAVOG_FUZZ_CHECK(std::isnan(r.p[i]) || (r.p[i] >= 0.0f && r.p[i] <= 1.0f),
+                         "reflection p %g at %zu", static_cast<double>(r.p[i]), i);
+        WAVOG_FUZZ_CHECK((grid[i] == -1) == std::isnan(r.p[i]), "reflection grid %d", grid[i]);
+      }
+    }
   }
   return out;
 }

@@ -103,6 +103,14 @@ struct MapParams {
   /// live as long as the map; 0: one per core. In [0, 256]. The map is bit-identical for every
   /// value; block selection and creation, and scans with one touched block, stay serial.
   int num_threads = 1;
+  /// Also keep a reflection probability map (paper section 1.2.2, eq. 1.3): per finest cell the
+  /// beams that ended in it (hits, the occupied band) and that crossed it (misses, E cells), under
+  /// the map's policy: "none" counts, "forget" forgets both by gamma (h <- (1-g) h + g [hit],
+  /// m <- (1-g) m + g [miss]), "max" counts hits only (the paper's compression), and the clamp
+  /// policies count unbounded (bounding hits and misses apart would bias p, paper section 1.3.3;
+  /// use "forget" for a bounded reflection map). Off by default: maps, speed and files are then
+  /// those without it.
+  bool reflection = false;
 
   /// Every violated rule, one line each, naming the parameter and its valid range. Empty: valid.
   std::vector<std::string> validate() const;

@@ -44,11 +44,12 @@ struct IntegrateStats {
 
 /// Size and work figures of a map.
 struct MapStats {
-  std::size_t blocks = 0;          ///< hashed blocks
-  std::size_t nodes = 0;           ///< live quadtree nodes (each holds 3 details)
-  std::size_t bytes = 0;           ///< bytes used: blocks, live node groups and the hash
-  std::size_t bytes_reserved = 0;  ///< bytes allocated: as `bytes`, but with every pool chunk
-                                   ///< ever allocated (the high-water mark; chunks are not freed)
+  std::size_t blocks = 0;            ///< hashed blocks
+  std::size_t nodes = 0;             ///< live quadtree nodes (each holds 3 details)
+  std::size_t bytes = 0;             ///< bytes used: blocks, live node groups and the hash
+  std::size_t reflection_bytes = 0;  ///< of them, the reflection layers' (MapParams::reflection)
+  std::size_t bytes_reserved = 0;    ///< bytes allocated: as `bytes`, but with every pool chunk
+                                     ///< ever allocated (the high-water mark; chunks are not freed)
   std::uint64_t nodes_visited_last = 0;  ///< nodes visited by the last integrate()
   std::uint64_t observed_cells = 0;      ///< finest cells ever observed (only if requested)
 };
@@ -70,10 +71,24 @@ struct Raster {
   double originY() const { return static_cast<double>(box.min_y) * cell_size; }
 };
 
+/// Reflection probabilities of one window at one scale (WaveletMap::exportReflection), row-major:
+/// p = hits / (hits + misses) summed over the finest cells under each raster cell; NaN where no
+/// cell under it was observed. With the "max" policy (hits only) p is 1 where a beam ended, else 0.
+struct ReflectionRaster {
+  int scale = 0;
+  double cell_size = 0.0;
+  CellBox box;
+  std::vector<float> p;
+  double originX() const { return static_cast<double>(box.min_x) * cell_size; }
+  double originY() const { return static_cast<double>(box.min_y) * cell_size; }
+};
+
 /// OccupancyGrid value of a log-odds: round(100 * P(occ)), in 0..100.
 std::int8_t occupancyFromLogOdds(float log_odds);
 /// OccupancyGrid values of a raster, same order: -1 where unknown, else occupancyFromLogOdds.
 std::vector<std::int8_t> toOccupancyGrid(const Raster& raster);
+/// OccupancyGrid values of reflection probabilities: -1 where NaN, else round(100 p).
+std::vector<std::int8_t> toOccupancyGrid(const ReflectionRaster& raster);
 
 /// A map file could not be written or read. what() names the file and the reason.
 class MapIoError : public std::runtime_error {
@@ -136,6 +151,12 @@ class WaveletMap {
   /// inside the window, not the whole map. Throws ReadoutTooLarge, allocating nothing, when the
   /// window has more than kMaxReadoutCells cells (readoutFits(window) is false).
   Raster exportScale(int scale, const CellBox& window, Aggregation aggregation) const;
+  /// MapParams::reflection only (else throws std::logic_error): the reflection probabilities of
+  /// `window` at scale s, exact at every scale (ratios of the Haar averages of hits and misses).
+  /// Same limits as exportScale (throws ReadoutTooLarge).
+  ReflectionRaster exportReflection(int scale, const CellBox& window) const;
+  /// MapParams::reflection only: p of one finest cell (NaN if never observed).
+  float reflection(const CellIndex& cell) const;
 
   /// Forgets everything: the whole map back to never observed.
   void reset();
@@ -164,6 +185,9 @@ class WaveletMap {
 
  private:
   friend struct MapAccess;  // tests inspect internals through this
+  /// A reflection layer (reflection.cpp): parameters made by the core, not validated.
+  struct LayerTag {};
+  WaveletMap(const MapParams& params, LayerTag);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -99,6 +99,9 @@ LayerSize layerBox(const wavog::WaveletMap& map, int scale, double window, doubl
 /// row-major from the lowest y, -1 unknown, 0..100 graded).
 nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
                                                 const std::string& frame, const ros::Time& stamp);
+/// Reflection probabilities as an OccupancyGrid (0..100 from p, -1 where never observed).
+nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::ReflectionRaster& raster,
+                                                const std::string& frame, const ros::Time& stamp);
 
 /// The raster as an update of a grid whose cell (0, 0) is the scale-s cell (grid_min_x,
 /// grid_min_y): x, y are the raster's offsets in that grid.

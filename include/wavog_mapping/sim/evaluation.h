@@ -63,6 +63,9 @@ struct EventResponse {
   /// Mean P(occ) over the event's cells, sampled every `sample_period` seconds.
   std::vector<double> times;
   std::vector<double> mean_occupancy;
+  /// With MapParams::reflection: mean reflection probability over the event's cells that have
+  /// one, at the same times (NaN while none has); else empty.
+  std::vector<double> mean_reflection;
   bool reached() const { return scans != std::numeric_limits<std::size_t>::max(); }
 };
 
