@@ -50,12 +50,12 @@ static_assert(rowsInCounterOrder(), "row i is counter i");
 
 }  // namespace
 
-std::uint32_t SeqGapCounter::next(std::uint32_t seq, const std::string& publisher) {
-  if (!have_ || publisher != publisher_) {
+std::uint32_t SeqGapCounter::next(std::uint32_t seq, std::uintptr_t connection) {
+  if (!have_ || connection != connection_) {
     have_ = true;
     trusted_ = false;
     last_ = seq;
-    publisher_ = publisher;
+    connection_ = connection;
     return 0;
   }
   const std::uint32_t step = seq - last_;  // modulo 2^32: a wrap-around is a step of 1

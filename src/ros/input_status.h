@@ -40,23 +40,25 @@ constexpr Counter droppedCounter(DropReason reason) {
 /// Scans lost before the node received them (roscpp's subscriber queue drops the oldest scan when
 /// the node is slower than the input, and tells nobody), from the gaps in header.seq of what is
 /// received. Drivers and rosbag keep seq; a publisher whose seq is always 0, or does not increase
-/// by 1, must not produce false counts: a gap counts only once seq has increased by exactly 1 from
-/// the same publisher, and trust is lost again when seq stands still or goes back (a restarted
-/// bag or driver) or the publisher changes.
+/// by 1, must not produce false counts: a gap counts only once seq has increased by exactly 1 on
+/// the same connection, and trust is lost again when seq stands still or goes back (a restarted
+/// bag or driver) or the connection changes (another publisher, a reconnect).
 class SeqGapCounter {
  public:
   /// A forward step larger than this is a restart (a new seq base), not a loss.
   static constexpr std::uint32_t kMaxGap = 100000;
 
-  /// The next received scan: its seq and its publisher (callerid). Returns how many scans are
-  /// missing between the previous one and this one (0 while seq is not trusted).
-  std::uint32_t next(std::uint32_t seq, const std::string& publisher);
+  /// The next received scan: its seq and an opaque id of the connection it came through (the
+  /// address of roscpp's connection header, never dereferenced: reading that map races with
+  /// roscpp's threads). Returns how many scans are missing between the previous one and this one
+  /// (0 while seq is not trusted).
+  std::uint32_t next(std::uint32_t seq, std::uintptr_t connection);
 
  private:
   bool have_ = false;     ///< a previous scan was seen
   bool trusted_ = false;  ///< seq increased by exactly 1 since the last reset
   std::uint32_t last_ = 0;
-  std::string publisher_;
+  std::uintptr_t connection_ = 0;
 };
 
 /// Counters and clocks of one input since start-up.

@@ -120,13 +120,18 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
           }));
   // The subscriber queue (subscriber_queue_size) holds bursts (several drivers on one host, fast
   // playback) until onScan runs; roscpp drops its oldest scan silently when it is full, which
-  // onScan counts from the gaps in header.seq. The event carries the publisher for that check.
+  // onScan counts from the gaps in header.seq per connection (the event's connection header,
+  // by address only: MessageEvent::getPublisherName() uses the map's operator[], which
+  // ThreadSanitizer shows racing with roscpp dropping the connection).
   in->sub = nh_.subscribe<LaserScan>(
       ic.topic, static_cast<std::uint32_t>(rp.subscriber_queue_size),
       boost::function<void(const ros::MessageEvent<const LaserScan>&)>(
           [this, raw](const ros::MessageEvent<const LaserScan>& event) {
             guarded("scan callback", raw,
-                    [&] { onScan(raw, event.getConstMessage(), event.getPublisherName()); });
+                    [&] {
+                      onScan(raw, event.getConstMessage(),
+                             reinterpret_cast<std::uintptr_t>(event.getConnectionHeaderPtr().get()));
+                    });
           }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   updater_->add(in->topic + " input", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {

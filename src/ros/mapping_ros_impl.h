@@ -80,10 +80,10 @@ struct MappingRos::Impl {
   std::vector<std::string> onReconfigure(const wavog_mapping::MappingConfig& rc);
 
   // ---- one scan (mapping_ros_scans.cpp), in the order a scan passes them
-  void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
-              const std::string& publisher);
+  /// `connection`: an opaque id of the connection the scan came through (SeqGapCounter).
+  void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan, std::uintptr_t connection);
   /// Counts the scans missing before `scan` (header.seq gaps) and warns. Under mutex_.
-  void countLostLocked(Input* in, const sensor_msgs::LaserScan& scan, const std::string& publisher);
+  void countLostLocked(Input* in, const sensor_msgs::LaserScan& scan, std::uintptr_t connection);
   void onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static);
   void onFilterFailure(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
                        tf2_ros::filter_failure_reasons::FilterFailureReason reason);

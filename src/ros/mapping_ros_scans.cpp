@@ -46,7 +46,7 @@ std::string refusalDetail(wavog::ScanStatus status) {
 }  // namespace
 
 void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& received,
-                              const std::string& publisher) {
+                              std::uintptr_t connection) {
   if (in->freq) in->freq->tick();  // FrequencyStatus locks itself
   noteActivity();
   const ros::Time now = ros::Time::now();
@@ -68,7 +68,7 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
     InputCounters& c = in->c;
     ++c[Counter::kReceived];
     ++c.received_in_period;
-    countLostLocked(in, *received, publisher);
+    countLostLocked(in, *received, connection);
     c.last_receipt = now;
     // The clock jumping backwards (a bag restarted with --clock): the tf buffer holds the old
     // future and would refuse every new scan, so clear it and go on.
@@ -116,8 +116,8 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
 }
 
 void MappingRos::Impl::countLostLocked(Input* in, const sensor_msgs::LaserScan& scan,
-                                       const std::string& publisher) {
-  const std::uint32_t lost = in->c.seq.next(scan.header.seq, publisher);
+                                       std::uintptr_t connection) {
+  const std::uint32_t lost = in->c.seq.next(scan.header.seq, connection);
   if (lost == 0) return;
   const std::uint64_t total = in->c[Counter::kLost] += lost;
   warnLocked(in, kLostWarning,
