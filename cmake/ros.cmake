@@ -64,6 +64,11 @@ if(CATKIN_ENABLE_TESTING)
       target_link_libraries(test_reconfigure wavog_ros ${GTEST_MAIN_LIBRARIES})
       add_dependencies(test_reconfigure ${PROJECT_NAME}_gencfg)
     endif()
+    # Scans lost before the node received them: header.seq gaps, no false counts.
+    catkin_add_gtest(test_seq_gaps test/ros/test_seq_gaps.cpp)
+    if(TARGET test_seq_gaps)
+      target_link_libraries(test_seq_gaps wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
     # The node's limits (issue 16): time checks, publication sizing, save_map below map_dir.
     catkin_add_gtest(test_node_limits test/ros/test_node_limits.cpp)
     if(TARGET test_node_limits)
@@ -89,6 +94,12 @@ if(CATKIN_ENABLE_TESTING)
       target_link_libraries(test_bad_input ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
       add_dependencies(test_bad_input ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
     endif()
+
+    # Lost scans: seq gaps counted exactly, seq 0 not counted, a burst fully accounted for.
+    add_rostest_gtest(test_lost_scans test/ros/lost_scans.test test/ros/test_lost_scans.cpp)
+    target_include_directories(test_lost_scans SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(test_lost_scans ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(test_lost_scans ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
 
     # Hostile input (issue 16): out-of-range time, huge read-outs, save_map outside map_dir,
     # map_file not a regular file.

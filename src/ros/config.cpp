@@ -161,6 +161,8 @@ const std::vector<KeyReader>& readers() {
       {"tf_tolerance", [](auto& k, auto& v, Config* c) { c->ros.tf_tolerance = asDouble(k, v); }},
       {"tf_cache_time", [](auto& k, auto& v, Config* c) { c->ros.tf_cache_time = asDouble(k, v); }},
       {"queue_size", [](auto& k, auto& v, Config* c) { c->ros.queue_size = asInt(k, v); }},
+      {"subscriber_queue_size",
+       [](auto& k, auto& v, Config* c) { c->ros.subscriber_queue_size = asInt(k, v); }},
       {"motion_compensation",
        [](auto& k, auto& v, Config* c) { c->ros.motion_compensation = asBool(k, v); }},
       {"map_file", [](auto& k, auto& v, Config* c) { c->ros.map_file = asString(k, v); }},
@@ -290,6 +292,9 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
         &e, "tf_cache_time (" + fmt(ros.tf_cache_time) + ") must be in [1, 3600] s");
   check(ros.queue_size >= 1 && ros.queue_size <= 1000, &e,
         "queue_size (" + std::to_string(ros.queue_size) + ") must be in [1, 1000]");
+  check(ros.subscriber_queue_size >= 1 && ros.subscriber_queue_size <= 100000, &e,
+        "subscriber_queue_size (" + std::to_string(ros.subscriber_queue_size) +
+            ") must be in [1, 100000]");
   check(ros.map_dir.empty() || (ros.map_dir[0] == '/' && ("/" + ros.map_dir + "/").find("/../") ==
                                                                std::string::npos),
         &e, "map_dir ('" + ros.map_dir + "') must be an absolute path without '..' (empty: the ROS home)");

@@ -16,6 +16,7 @@ struct CounterRow {
 constexpr CounterRow kRows[] = {
     {Counter::kReceived, "received", &InputStatus::received},
     {Counter::kIntegrated, "integrated", &InputStatus::integrated},
+    {Counter::kLost, "lost (header.seq gaps)", &InputStatus::lost},
     {droppedCounter(DropReason::kEmpty), "dropped empty", &InputStatus::dropped_empty},
     {droppedCounter(DropReason::kSizeMismatch), "dropped size_mismatch",
      &InputStatus::dropped_size_mismatch},
@@ -48,6 +49,27 @@ constexpr bool rowsInCounterOrder() {
 static_assert(rowsInCounterOrder(), "row i is counter i");
 
 }  // namespace
+
+std::uint32_t SeqGapCounter::next(std::uint32_t seq, std::uintptr_t connection) {
+  if (!have_ || connection != connection_) {
+    have_ = true;
+    trusted_ = false;
+    last_ = seq;
+    connection_ = connection;
+    return 0;
+  }
+  const std::uint32_t step = seq - last_;  // modulo 2^32: a wrap-around is a step of 1
+  last_ = seq;
+  if (step == 1) {
+    trusted_ = true;
+    return 0;
+  }
+  if (step == 0 || step > kMaxGap) {  // standing still, going back, or a new base
+    trusted_ = false;
+    return 0;
+  }
+  return trusted_ ? step - 1 : 0;
+}
 
 std::uint64_t InputCounters::dropped() const {
   std::uint64_t n = 0;

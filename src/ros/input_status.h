@@ -21,6 +21,7 @@ namespace wavog_ros {
 enum class Counter : std::size_t {
   kReceived,
   kIntegrated,
+  kLost,          ///< never received: gaps in header.seq (SeqGapCounter)
   kDroppedFirst,  ///< + DropReason: dropped_empty ... dropped_bad_geometry
   kTimeJumps = kDroppedFirst + kNumDropReasons,
   kMotionFallbacks,
@@ -36,6 +37,30 @@ constexpr Counter droppedCounter(DropReason reason) {
                               static_cast<std::size_t>(reason));
 }
 
+/// Scans lost before the node received them (roscpp's subscriber queue drops the oldest scan when
+/// the node is slower than the input, and tells nobody), from the gaps in header.seq of what is
+/// received. Drivers and rosbag keep seq; a publisher whose seq is always 0, or does not increase
+/// by 1, must not produce false counts: a gap counts only once seq has increased by exactly 1 on
+/// the same connection, and trust is lost again when seq stands still or goes back (a restarted
+/// bag or driver) or the connection changes (another publisher, a reconnect).
+class SeqGapCounter {
+ public:
+  /// A forward step larger than this is a restart (a new seq base), not a loss.
+  static constexpr std::uint32_t kMaxGap = 100000;
+
+  /// The next received scan: its seq and an opaque id of the connection it came through (the
+  /// address of roscpp's connection header, never dereferenced: reading that map races with
+  /// roscpp's threads). Returns how many scans are missing between the previous one and this one
+  /// (0 while seq is not trusted).
+  std::uint32_t next(std::uint32_t seq, std::uintptr_t connection);
+
+ private:
+  bool have_ = false;     ///< a previous scan was seen
+  bool trusted_ = false;  ///< seq increased by exactly 1 since the last reset
+  std::uint32_t last_ = 0;
+  std::uintptr_t connection_ = 0;
+};
+
 /// Counters and clocks of one input since start-up.
 struct InputCounters {
   std::array<std::uint64_t, kNumCounters> count{};
@@ -44,6 +69,7 @@ struct InputCounters {
   ros::Time last_received_stamp;         ///< of the last received scan (time-jump check)
   ros::Time last_receipt;                ///< clock time of the last receipt (stale check)
   double rate = 0.0;                     ///< measured over the last status period (Hz)
+  SeqGapCounter seq;                     ///< Counter::kLost from header.seq
 
   std::uint64_t& operator[](Counter c) { return count[static_cast<std::size_t>(c)]; }
   std::uint64_t operator[](Counter c) const { return count[static_cast<std::size_t>(c)]; }

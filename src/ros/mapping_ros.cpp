@@ -12,9 +12,8 @@
 namespace wavog_ros {
 namespace {
 
-/// Subscriber queue per input: bursts (several drivers on one host) must not be lost before the
-/// scans reach the tf MessageFilter, whose own queue is the queue_size parameter.
-constexpr std::uint32_t kSubscriberQueue = 50;
+/// Smallest /tf and /tf_static subscriber queue (the size roscpp's TransformListener uses).
+constexpr int kMinTfQueue = 100;
 /// Period (s) of the /diagnostics updater.
 constexpr double kDiagnosticsPeriod = 0.5;
 
@@ -80,9 +79,13 @@ MappingRos::Impl::~Impl() {
 void MappingRos::Impl::subscribeTf() {
   buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(config_.ros.tf_cache_time));
   ros::NodeHandle root;
+  // As deep as the scans' queues: when the node stalls, roscpp would otherwise drop the oldest tf
+  // and hand the queued scans a buffer that has moved on (they would be dropped as tf too old).
+  const auto queue =
+      static_cast<std::uint32_t>(std::max(kMinTfQueue, config_.ros.subscriber_queue_size));
   for (const bool is_static : {false, true}) {
     (is_static ? tf_static_sub_ : tf_sub_) = root.subscribe<tf2_msgs::TFMessage>(
-        is_static ? "/tf_static" : "/tf", 100,
+        is_static ? "/tf_static" : "/tf", queue,
         boost::function<void(const tf2_msgs::TFMessage::ConstPtr&)>(
             [this, is_static](const tf2_msgs::TFMessage::ConstPtr& m) {
               guarded("tf callback", nullptr, [&] { onTf(m, is_static); });
@@ -115,11 +118,20 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
             guarded("tf filter failure callback", nullptr,
                     [&] { onFilterFailure(raw, scan, reason); });
           }));
+  // The subscriber queue (subscriber_queue_size) holds bursts (several drivers on one host, fast
+  // playback) until onScan runs; roscpp drops its oldest scan silently when it is full, which
+  // onScan counts from the gaps in header.seq per connection (the event's connection header,
+  // by address only: MessageEvent::getPublisherName() uses the map's operator[], which
+  // ThreadSanitizer shows racing with roscpp dropping the connection).
   in->sub = nh_.subscribe<LaserScan>(
-      ic.topic, kSubscriberQueue,
-      boost::function<void(const LaserScan::ConstPtr&)>(
-          [this, raw](const LaserScan::ConstPtr& scan) {
-            guarded("scan callback", raw, [&] { onScan(raw, scan); });
+      ic.topic, static_cast<std::uint32_t>(rp.subscriber_queue_size),
+      boost::function<void(const ros::MessageEvent<const LaserScan>&)>(
+          [this, raw](const ros::MessageEvent<const LaserScan>& event) {
+            guarded("scan callback", raw,
+                    [&] {
+                      onScan(raw, event.getConstMessage(),
+                             reinterpret_cast<std::uintptr_t>(event.getConnectionHeaderPtr().get()));
+                    });
           }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   updater_->add(in->topic + " input", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {

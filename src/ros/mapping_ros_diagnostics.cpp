@@ -24,7 +24,14 @@ void MappingRos::Impl::diagnoseInput(const Input* in,
   const double since = secondsBetween(ros::Time::now(), c.last_receipt);
   const double expected = in->config.expected_rate;
   const double stale_after = expected > 0.0 ? kStalePeriods / expected : kStalePeriods;
-  if (c[Counter::kReceived] == 0) {
+  const std::uint64_t new_lost = c[Counter::kLost] - in->lost_reported;
+  in->lost_reported = c[Counter::kLost];
+  if (new_lost > 0) {
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                  "%llu scans lost since last report (subscriber queue overflow: the node is "
+                  "slower than the input)",
+                  static_cast<unsigned long long>(new_lost));
+  } else if (c[Counter::kReceived] == 0) {
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no scan received yet");
   } else if (since > std::max(stale_after, kMinStaleSeconds)) {
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "stale: no scan for %.1f s", since);

@@ -51,11 +51,14 @@ struct Input {
   std::string topic;  ///< resolved name
   ros::Subscriber sub;
   std::unique_ptr<ScanFilter> filter;
-  InputCounters c;                                           ///< guarded by Impl::mutex_
-  std::array<ros::WallTime, kNumDropReasons + 1> last_warn;  ///< + 1: time jumps, fallbacks
+  InputCounters c;  ///< guarded by Impl::mutex_
+  /// Last warning per drop reason, then: time jumps and fallbacks (kOtherWarning), lost scans.
+  std::array<ros::WallTime, kNumDropReasons + 2> last_warn;
   double min_freq = 0.0;  ///< diagnostics bounds (the FrequencyStatus keeps pointers to them)
   double max_freq = 0.0;
   diagnostic_updater::FrequencyStatus* freq = nullptr;  ///< owned by Impl::freq_; may be null
+  /// Lost scans at the last /diagnostics update (guarded by Impl::mutex_).
+  mutable std::uint64_t lost_reported = 0;
   bool slash_warned = false;  ///< the leading-'/' warning was given (guarded by Impl::mutex_)
   wavog::ScanPeriod period;   ///< of this laser's scans, for forget_half_life (Impl::mutex_)
   /// Scans handed to the tf filter and not yet out of it (integrated, dropped or flushed), oldest
@@ -77,7 +80,10 @@ struct MappingRos::Impl {
   std::vector<std::string> onReconfigure(const wavog_mapping::MappingConfig& rc);
 
   // ---- one scan (mapping_ros_scans.cpp), in the order a scan passes them
-  void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan);
+  /// `connection`: an opaque id of the connection the scan came through (SeqGapCounter).
+  void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan, std::uintptr_t connection);
+  /// Counts the scans missing before `scan` (header.seq gaps) and warns. Under mutex_.
+  void countLostLocked(Input* in, const sensor_msgs::LaserScan& scan, std::uintptr_t connection);
   void onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static);
   void onFilterFailure(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
                        tf2_ros::filter_failure_reasons::FilterFailureReason reason);

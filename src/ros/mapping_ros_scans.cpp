@@ -22,6 +22,8 @@ using Clock = std::chrono::steady_clock;
 constexpr double kTimeJumpThreshold = 1.0;
 /// Warning slot (Input::last_warn) shared by time jumps and motion fallbacks.
 constexpr std::size_t kOtherWarning = kNumDropReasons;
+/// Warning slot (Input::last_warn) of scans lost before the node received them.
+constexpr std::size_t kLostWarning = kNumDropReasons + 1;
 
 /// Why the core refused a scan, as a drop reason.
 DropReason refusal(wavog::ScanStatus status) {
@@ -43,7 +45,8 @@ std::string refusalDetail(wavog::ScanStatus status) {
 
 }  // namespace
 
-void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& received) {
+void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& received,
+                              std::uintptr_t connection) {
   if (in->freq) in->freq->tick();  // FrequencyStatus locks itself
   noteActivity();
   const ros::Time now = ros::Time::now();
@@ -65,6 +68,7 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
     InputCounters& c = in->c;
     ++c[Counter::kReceived];
     ++c.received_in_period;
+    countLostLocked(in, *received, connection);
     c.last_receipt = now;
     // The clock jumping backwards (a bag restarted with --clock): the tf buffer holds the old
     // future and would refuse every new scan, so clear it and go on.
@@ -111,6 +115,23 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
   in->filter->add(scan);
 }
 
+void MappingRos::Impl::countLostLocked(Input* in, const sensor_msgs::LaserScan& scan,
+                                       std::uintptr_t connection) {
+  const std::uint32_t lost = in->c.seq.next(scan.header.seq, connection);
+  if (lost == 0) return;
+  const std::uint64_t total = in->c[Counter::kLost] += lost;
+  warnLocked(in, kLostWarning,
+             std::to_string(lost) + " scan(s) lost before the node received them (header.seq " +
+                 std::to_string(scan.header.seq - lost - 1) + " -> " +
+                 std::to_string(scan.header.seq) + ", " + std::to_string(total) +
+                 " lost so far), most likely dropped by a full subscriber queue "
+                 "(subscriber_queue_size " +
+                 std::to_string(config_.ros.subscriber_queue_size) +
+                 "): the node is slower than this input. Raise subscriber_queue_size, play the "
+                 "bag slower (rosbag play -r), or give the node more CPU (a less loaded host, "
+                 "fewer publish_scales, a coarser resolution, num_threads)");
+}
+
 void MappingRos::Impl::onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static) {
   noteActivity();
   std::uint64_t refused = 0;
@@ -151,8 +172,12 @@ void MappingRos::Impl::onFilterFailure(
   } else if (reason == tf2_ros::filter_failure_reasons::EmptyFrameID) {
     dropLocked(in, DropReason::kBadFrame, "empty frame_id");
   } else {
+    // Unknown: tf never came in time, or the filter's queue overflowed (it drops its oldest scan
+    // when more than queue_size wait for tf).
     dropLocked(in, DropReason::kTfUnavailable,
-               "no transform to '" + placement_.fixed_frame + "' (unknown frame or tf late)");
+               "no transform to '" + placement_.fixed_frame +
+                   "' (unknown frame, tf late, or more than queue_size " +
+                   std::to_string(config_.ros.queue_size) + " scans waiting for tf)");
   }
 }
 

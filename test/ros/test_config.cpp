@@ -63,6 +63,7 @@ void expectSame(const Config& a, const Config& b) {
   EXPECT_EQ(a.ros.tf_tolerance, b.ros.tf_tolerance);
   EXPECT_EQ(a.ros.tf_cache_time, b.ros.tf_cache_time);
   EXPECT_EQ(a.ros.queue_size, b.ros.queue_size);
+  EXPECT_EQ(a.ros.subscriber_queue_size, b.ros.subscriber_queue_size);
   EXPECT_EQ(a.ros.motion_compensation, b.ros.motion_compensation);
   EXPECT_EQ(a.ros.map_file, b.ros.map_file);
   EXPECT_EQ(a.ros.rate_tolerance, b.ros.rate_tolerance);
@@ -150,6 +151,9 @@ TEST(Config, BadValuesNameTheParameterAndItsRange) {
   EXPECT_NE(errorOf("inputs: [a, b, c, d, e]").find("1 to 4"), std::string::npos);
   EXPECT_NE(errorOf("inputs: [a, a]").find("twice"), std::string::npos);
   EXPECT_NE(errorOf("queue_size: 0").find("queue_size (0) must be in [1, 1000]"),
+            std::string::npos);
+  EXPECT_NE(errorOf("subscriber_queue_size: 0")
+                .find("subscriber_queue_size (0) must be in [1, 100000]"),
             std::string::npos);
   EXPECT_NE(errorOf("tf_tolerance: 2").find("tf_tolerance"), std::string::npos);
   EXPECT_NE(errorOf("map_frame: /map").find("map_frame"), std::string::npos);

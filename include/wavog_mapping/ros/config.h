@@ -53,6 +53,11 @@ struct RosParams {
   double tf_cache_time = 30.0;
   /// Scans per input waiting for tf in the MessageFilter, in [1, 1000].
   int queue_size = 20;
+  /// Scans per input roscpp holds between the socket and the node's callback, in [1, 100000].
+  /// roscpp silently drops the oldest when it is full (the node is slower than the input); the
+  /// node counts those from gaps in header.seq (InputStatus::lost). /tf and /tf_static get
+  /// queues as deep (at least 100), so queued scans find their tf after a stall.
+  int subscriber_queue_size = 1000;
   /// Place each beam with the sensor pose interpolated over the sweep (needs time_increment).
   bool motion_compensation = true;
   /// Native map file loaded at start-up; empty: start with an empty map.
