@@ -106,9 +106,11 @@ geometry_msgs::TransformStamped toTransform(const std::string& parent, const std
   return t;
 }
 
+// `seq`: the scan's number on its topic (from 1), so that a node can count the scans it never got.
 sensor_msgs::LaserScan toLaserScan(const wavog::CarmenScan& scan, const std::string& frame,
-                                   const ros::Time& stamp, double range_min) {
+                                   const ros::Time& stamp, double range_min, std::uint32_t seq) {
   sensor_msgs::LaserScan msg;
+  msg.header.seq = seq;
   msg.header.stamp = stamp;
   msg.header.frame_id = frame;
   msg.angle_min = static_cast<float>(scan.angle_min);
@@ -152,8 +154,8 @@ class BagWriter {
     last_base_ = o_.odom ? scan.robot_pose
                          : wavog_tools::compose(scan.laser_pose, wavog_tools::inverse(laser.mount));
     writeTf(last_base_, stamp);
-    bag_.write(laser.topic, stamp, toLaserScan(scan, laser.frame, stamp, o_.range_min));
-    ++per_topic_[laser.topic];
+    const auto seq = static_cast<std::uint32_t>(++per_topic_[laser.topic]);
+    bag_.write(laser.topic, stamp, toLaserScan(scan, laser.frame, stamp, o_.range_min, seq));
     ++written_;
   }
 

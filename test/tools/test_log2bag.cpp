@@ -1,6 +1,6 @@
 // Tests of wavog_log2bag, run as a program: the first 300 scans of fr079 (FLASER, relative stamps)
 // and of csail (ROBOTLASER1, absolute stamps) converted and read back with the rosbag API (topics,
-// counts, types, strictly increasing stamps, frames, REP 117 ranges, tf composing to the logged
+// counts, types, seq from 1, strictly increasing stamps, frames, REP 117 ranges, tf composing to the logged
 // laser pose); malformed lines (lenient and --strict); a truncated .gz; time stamp repairs.
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
@@ -97,6 +97,7 @@ void checkConversion(const std::string& log, const BagContent& c, std::size_t n)
   for (std::size_t i = 0; i < n; ++i) {
     const sensor_msgs::LaserScan& s = c.scans[i];
     EXPECT_EQ(s.header.frame_id, "front_laser");
+    EXPECT_EQ(s.header.seq, i + 1) << "numbered from 1, so that a node counts scans it never got";
     EXPECT_EQ(s.header.stamp, c.scan_bag_times[i]);
     if (i > 0) {
       EXPECT_GT(s.header.stamp, c.scans[i - 1].header.stamp) << "scan " << i;
