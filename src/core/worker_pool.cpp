@@ -1,6 +1,7 @@
 // WorkerPool (worker_pool.h): a generation counter that workers poll for a while after each job,
 // then wait for on a condition variable; the caller polls the count of running workers the same
-// way. The mutex orders every sleep against every notification, so no wake-up is lost.
+// way. The mutex orders every sleep against every notification, so no wake-up is lost, and every
+// worker's end of a job against the caller's return.
 #include "worker_pool.h"
 
 #include <chrono>
@@ -72,10 +73,10 @@ void WorkerPool::loop(int t) {
       job = job_;
     }
     (*job)(t);
-    if (running_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
-      std::lock_guard<std::mutex> lock(mu_);  // the caller is polling or waiting under mu_
-      done_.notify_one();
-    }
+    // Under mu_, which the caller takes after the job (also when it saw the count reach 0 while
+    // polling): every worker's writes then happen before the caller goes on, through the mutex.
+    std::lock_guard<std::mutex> lock(mu_);
+    if (running_.fetch_sub(1, std::memory_order_acq_rel) == 1) done_.notify_one();
   }
 }
 
