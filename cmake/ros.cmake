@@ -75,69 +75,51 @@ if(CATKIN_ENABLE_TESTING)
       target_link_libraries(test_node_limits wavog_ros ${GTEST_MAIN_LIBRARIES})
     endif()
   endif()
+  # A rostest with its own gtest binary: the node's message headers, catkin's and gtest's
+  # libraries, built after the messages and the node.
+  function(wavog_rostest_gtest target launch source)
+    add_rostest_gtest(${target} ${launch} ${source})
+    target_include_directories(${target} SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+    target_link_libraries(${target} ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    add_dependencies(${target} ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+  endfunction()
+
   if(TARGET wavog_mapping_node)
     find_package(rostest REQUIRED)
     find_package(roslaunch REQUIRED)
     set(WAVOG_ROS_RUNTIME wavog_mapping_node wavog_mapping_nodelet)
 
     # Integration: the same gtest against the node and against the nodelet, plus hztests.
-    add_rostest_gtest(test_mapping_system test/mapping_node.test test/ros/test_mapping_system.cpp)
-    target_include_directories(test_mapping_system SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(test_mapping_system ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-    add_dependencies(test_mapping_system ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    wavog_rostest_gtest(test_mapping_system test/mapping_node.test test/ros/test_mapping_system.cpp)
     add_rostest(test/mapping_nodelet.test DEPENDENCIES test_mapping_system)
 
     # Bad inputs: every malformed scan counted by reason, the node stays up.
     if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_bad_input.cpp)
-      add_rostest_gtest(test_bad_input test/bad_input.test test/ros/test_bad_input.cpp)
-      target_include_directories(test_bad_input SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-      target_link_libraries(test_bad_input ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-      add_dependencies(test_bad_input ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+      wavog_rostest_gtest(test_bad_input test/bad_input.test test/ros/test_bad_input.cpp)
     endif()
 
     # Lost scans: seq gaps counted exactly, seq 0 not counted, a burst fully accounted for.
-    add_rostest_gtest(test_lost_scans test/ros/lost_scans.test test/ros/test_lost_scans.cpp)
-    target_include_directories(test_lost_scans SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(test_lost_scans ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-    add_dependencies(test_lost_scans ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    wavog_rostest_gtest(test_lost_scans test/ros/lost_scans.test test/ros/test_lost_scans.cpp)
 
     # Hostile input (issue 16): out-of-range time, huge read-outs, save_map outside map_dir,
     # map_file not a regular file.
-    add_rostest_gtest(test_hostile_input test/hostile_input.test test/ros/test_hostile_input.cpp)
-    target_include_directories(test_hostile_input SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(test_hostile_input ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-    add_dependencies(test_hostile_input ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    wavog_rostest_gtest(test_hostile_input test/hostile_input.test test/ros/test_hostile_input.cpp)
     target_compile_definitions(test_hostile_input PRIVATE
       WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
 
-    # Sim time jumping backwards (bag restart): tf buffer cleared, mapping goes on.
-    add_rostest_gtest(test_half_life_rates test/half_life_rates.test
+    # forget_half_life with inputs of two rates; the reflection layers' topics.
+    wavog_rostest_gtest(test_half_life_rates test/half_life_rates.test
       test/ros/test_half_life_rates.cpp)
-    target_include_directories(test_half_life_rates SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(test_half_life_rates ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-    add_dependencies(test_half_life_rates ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
-    add_rostest_gtest(test_reflection_topics test/reflection_topics.test
+    wavog_rostest_gtest(test_reflection_topics test/reflection_topics.test
       test/ros/test_reflection_topics.cpp)
-    target_include_directories(test_reflection_topics SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(test_reflection_topics ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-    add_dependencies(test_reflection_topics ${PROJECT_NAME}_generate_messages_cpp
-      ${WAVOG_ROS_RUNTIME})
-    add_rostest_gtest(test_clock_jump test/clock_jump.test test/ros/test_clock_jump.cpp)
-    target_include_directories(test_clock_jump SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(test_clock_jump ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-    add_dependencies(test_clock_jump ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    # Sim time jumping backwards (bag restart): tf buffer cleared, mapping goes on.
+    wavog_rostest_gtest(test_clock_jump test/clock_jump.test test/ros/test_clock_jump.cpp)
 
     # Motion compensation through ROS: a moving scanner, compensation on and off.
-    add_rostest_gtest(test_motion test/motion.test test/ros/test_motion.cpp)
-    target_include_directories(test_motion SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(test_motion ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-    add_dependencies(test_motion ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    wavog_rostest_gtest(test_motion test/motion.test test/ros/test_motion.cpp)
 
     # The end of a played bag: '/' frames, no tf for one laser, last scans after the last tf.
-    add_rostest_gtest(test_bag_end test/bag_end.test test/ros/test_bag_end.cpp)
-    target_include_directories(test_bag_end SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(test_bag_end ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-    add_dependencies(test_bag_end ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+    wavog_rostest_gtest(test_bag_end test/bag_end.test test/ros/test_bag_end.cpp)
 
     # Live reconfigure of the policy against a core-only map; an invalid change refused.
     add_rostest_gtest(test_reconfigure_policy test/reconfigure_policy.test
@@ -150,10 +132,7 @@ if(CATKIN_ENABLE_TESTING)
     find_program(WAVOG_NODELET_BIN nodelet PATHS /usr/lib/nodelet ${nodelet_PREFIX}/lib/nodelet
                  NO_DEFAULT_PATH)
     if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_services.cpp)
-      add_rostest_gtest(test_services test/services.test test/ros/test_services.cpp)
-      target_include_directories(test_services SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-      target_link_libraries(test_services ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
-      add_dependencies(test_services ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
+      wavog_rostest_gtest(test_services test/services.test test/ros/test_services.cpp)
       target_compile_definitions(test_services PRIVATE
         WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node"
         WAVOG_NODELET_BIN="${WAVOG_NODELET_BIN}")
