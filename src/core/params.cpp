@@ -104,6 +104,10 @@ std::vector<std::string> MapParams::validate() const {
         skip_tolerance, "in [0, 1] log-odds", &v);
   check(num_threads >= 0 && num_threads <= kMaxThreads, "num_threads", num_threads,
         "an integer in [0, 256] (0: one per core)", &v);
+  check(finite(ndt_min_weight) && ndt_min_weight >= 0.0 && ndt_min_weight <= 1e6, "ndt_min_weight",
+        ndt_min_weight, "in [0, 1e6] (end-points)", &v);
+  check(finite(ndt_max_weight) && ndt_max_weight >= 1.0 && ndt_max_weight <= 1e9, "ndt_max_weight",
+        ndt_max_weight, "in [1, 1e9] (end-points)", &v);
   // clamp_min < clamp_max needs no rule of its own: the two rules above force their signs.
   return v;
 }

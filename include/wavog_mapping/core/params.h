@@ -111,6 +111,18 @@ struct MapParams {
   /// use "forget" for a bounded reflection map). Off by default: maps, speed and files are then
   /// those without it.
   bool reflection = false;
+  /// Also keep normal-distribution cells (paper section 1.2.3, Biber's NDT): per finest cell the
+  /// weight, mean and covariance of the beam end-points that fell in it, with the map's policy
+  /// applied to the weight: "none" and "max" sum the end-points, "forget" weighs the old
+  /// moments by (1-g) at every observation of the cell (E or O) and each new end-point by g,
+  /// "clamp" and "clamp_upper" cap the weight at ndt_max_weight by scaling the old moments down
+  /// (a window of the latest end-points), "clamp_lower" sums. Coarse scales merge their cells'
+  /// moments exactly. Off by default: maps, speed and files are then those without it.
+  bool ndt = false;
+  /// ndt: a cell whose weight falls under this drops its Gaussian, in [0, 1e6].
+  double ndt_min_weight = 0.01;
+  /// ndt with "clamp" / "clamp_upper": the largest weight of a cell, in [1, 1e9].
+  double ndt_max_weight = 100.0;
 
   /// Every violated rule, one line each, naming the parameter and its valid range. Empty: valid.
   std::vector<std::string> validate() const;

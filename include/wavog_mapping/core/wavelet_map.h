@@ -48,6 +48,8 @@ struct MapStats {
   std::size_t nodes = 0;             ///< live quadtree nodes (each holds 3 details)
   std::size_t bytes = 0;             ///< bytes used: blocks, live node groups and the hash
   std::size_t reflection_bytes = 0;  ///< of them, the reflection layers' (MapParams::reflection)
+  std::size_t ndt_cells = 0;         ///< finest cells holding a Gaussian (MapParams::ndt)
+  std::size_t ndt_bytes = 0;         ///< of `bytes`, the Gaussians' (MapParams::ndt)
   std::size_t bytes_reserved = 0;    ///< bytes allocated: as `bytes`, but with every pool chunk
                                      ///< ever allocated (the high-water mark; chunks are not freed)
   std::uint64_t nodes_visited_last = 0;  ///< nodes visited by the last integrate()
@@ -81,6 +83,25 @@ struct ReflectionRaster {
   std::vector<float> p;
   double originX() const { return static_cast<double>(box.min_x) * cell_size; }
   double originY() const { return static_cast<double>(box.min_y) * cell_size; }
+};
+
+/// One normal-distribution cell (MapParams::ndt): the Gaussian of the beam end-points that fell
+/// in a cell, weighted by the map's policy. At scale s it merges the finest cells' moments exactly.
+struct NdtCell {
+  std::int64_t ix = 0, iy = 0;             ///< the cell, in scale-s cell units
+  double weight = 0.0;                     ///< end-points it holds, as weighted by the policy
+  double mean_x = 0.0, mean_y = 0.0;       ///< mean of the end-points (map frame, m)
+  double cov_xx = 0.0, cov_xy = 0.0, cov_yy = 0.0;  ///< their covariance (m^2; 0 for one point)
+  float log_odds = 0.0f;                   ///< the cell's occupancy at that scale (Haar average)
+};
+
+/// The normal-distribution cells of one window at one scale (WaveletMap::exportNdt), sorted by
+/// (iy, ix); only cells holding a Gaussian appear.
+struct NdtLayer {
+  int scale = 0;
+  double cell_size = 0.0;
+  CellBox box;
+  std::vector<NdtCell> cells;
 };
 
 /// OccupancyGrid value of a log-odds: round(100 * P(occ)), in 0..100.
@@ -157,6 +178,12 @@ class WaveletMap {
   ReflectionRaster exportReflection(int scale, const CellBox& window) const;
   /// MapParams::reflection only: p of one finest cell (NaN if never observed).
   float reflection(const CellIndex& cell) const;
+  /// MapParams::ndt only (else throws std::logic_error): the Gaussians of `window` at scale s in
+  /// [0, block_levels], each merging the finest cells under it. Cost follows the stored Gaussians
+  /// of the blocks the window meets; any window is taken (nothing dense is allocated).
+  NdtLayer exportNdt(int scale, const CellBox& window) const;
+  /// MapParams::ndt only: the Gaussian of one finest cell; false when it holds none.
+  bool ndtCell(const CellIndex& cell, NdtCell* out) const;
 
   /// Forgets everything: the whole map back to never observed.
   void reset();
