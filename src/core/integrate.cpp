@@ -11,13 +11,20 @@
 #include <utility>
 #include <vector>
 
+#include "block_update.h"
 #include "map_impl.h"
-#include "ndt_update.h"
-#include "quadtree_update.h"
 #include "scan_classifier.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
+namespace detail {
+// The update with the Gaussians' forgetting is compiled in its own file (integrate_ndt.cpp), so
+// that it does not change how the compiler inlines the others.
+extern template std::uint64_t updateBlocks<PolicyType::kForget, true>(
+    WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&, const NdtConsts*,
+    const std::vector<BlockJob>&, std::atomic<std::size_t>*);
+}  // namespace detail
+
 namespace {
 
 using detail::ScanClassifier;
@@ -35,14 +42,6 @@ CellBox reachBox(double px, double py, double reach, double res) {
   box.max_y = static_cast<std::int64_t>(std::floor((py + reach) / res)) + 1;
   return box;
 }
-
-// One block of the scan: its storage, origin cell and class, and its end-points (MapParams::ndt).
-struct BlockJob {
-  detail::Block* block;
-  std::int64_t ix0, iy0;
-  detail::SquareInfo box;
-  const detail::NdtPoint *points = nullptr, *points_end = nullptr;
-};
 
 // The NDT policy of one scan (params.h, MapParams::ndt): forgetting by the scan's rate, the
 // clamp policies' weight cap, sums otherwise.
@@ -75,40 +74,32 @@ int threadsFor(const MapParams& p) {
 // integration finish together instead of one of them starting a heavy block last: blocks that may
 // hold hits (kMixed) before free or partly unknown ones, nearer the sensor (more beams, more
 // cells of the fan) before farther. Only the order of the work changes, not its result.
-void orderByWork(const detail::PreparedScan& ps, double block_size, std::vector<BlockJob>* jobs) {
-  const auto cost_rank = [&](const BlockJob& j) {
+void orderByWork(const detail::PreparedScan& ps, double block_size,
+                 std::vector<detail::BlockJob>* jobs) {
+  const auto cost_rank = [&](const detail::BlockJob& j) {
     const double res = ps.res;
     const double cx = (static_cast<double>(j.ix0) * res + 0.5 * block_size) - ps.px;
     const double cy = (static_cast<double>(j.iy0) * res + 0.5 * block_size) - ps.py;
     return std::make_pair(j.box.cls == CellClass::kMixed ? 0 : 1, cx * cx + cy * cy);
   };
-  std::stable_sort(jobs->begin(), jobs->end(), [&](const BlockJob& a, const BlockJob& b) {
-    return cost_rank(a) < cost_rank(b);
-  });
+  std::stable_sort(jobs->begin(), jobs->end(),
+                   [&](const detail::BlockJob& a, const detail::BlockJob& b) {
+                     return cost_rank(a) < cost_rank(b);
+                   });
 }
 
-// Updates the blocks jobs[i] for the indices i taken from `next` (shared by the threads of one
-// scan); node groups from `store`; with `ndt`, their Gaussians too. Returns the nodes visited.
-// The one place Integrator<P> is made, so the hot code is compiled once per policy.
 template <PolicyType P>
-[[gnu::noinline]] std::uint64_t updateBlocks(WaveletMap::Impl& impl, detail::NodeStore& store,
-                                             const ScanClassifier& cls,
-                                             const detail::PolicyConsts& pc,
-                                             const detail::NdtConsts* ndt,
-                                             const std::vector<BlockJob>& jobs,
-                                             std::atomic<std::size_t>* next) {
-  detail::Integrator<P> integrator(impl, store, cls, pc);
-  for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < jobs.size();
-       i = next->fetch_add(1, std::memory_order_relaxed)) {
-    const BlockJob& j = jobs[i];
-    store.useSpare(&j.block->spare);
-    integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
-    if (ndt != nullptr && j.block->ndt) {
-      detail::NdtBlockUpdate(cls, *ndt, impl.levels)
-          .update(*j.block->ndt, j.ix0, j.iy0, j.box, j.points, j.points_end);
+std::uint64_t updateBlocksFor(WaveletMap::Impl& impl, detail::NodeStore& store,
+                              const ScanClassifier& cls, const detail::PolicyConsts& pc,
+                              const detail::NdtConsts* ndt,
+                              const std::vector<detail::BlockJob>& jobs,
+                              std::atomic<std::size_t>* next) {
+  if constexpr (P == PolicyType::kForget) {  // the one policy whose observations change them
+    if (ndt != nullptr && ndt->a != 1.0) {
+      return detail::updateBlocks<P, true>(impl, store, cls, pc, ndt, jobs, next);
     }
   }
-  return integrator.visited();
+  return detail::updateBlocks<P, false>(impl, store, cls, pc, ndt, jobs, next);
 }
 
 // `workers`: the map's worker threads (made here on first use), shared by its reflection layers.
@@ -134,8 +125,8 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
   const CellBox blocks = reachBox(ps.px, ps.py, ps.reach, block_size);
   // Serial: classify the blocks and create the touched ones (the hash changes only here, in the
   // same order whatever the thread count, so its iteration order, and the saved file, are too).
-  thread_local std::vector<BlockJob> job_buffer;  // reused from scan to scan
-  std::vector<BlockJob>& jobs = job_buffer;       // the workers read this thread's copy
+  thread_local std::vector<detail::BlockJob> job_buffer;  // reused from scan to scan
+  std::vector<detail::BlockJob>& jobs = job_buffer;       // the workers read this thread's copy
   jobs.clear();
   std::uint64_t visited = 0;
   for (std::int64_t by = blocks.min_y; by < blocks.max_y; ++by) {
@@ -155,9 +146,10 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     ndt_consts = ndtConsts(p, a, g);
     ndt = &ndt_consts;
     ndt_points.build(ps, L);
-    for (BlockJob& j : jobs) {
-      ndt_points.inBlock(detail::blockKey(detail::floorShift(j.ix0, L), detail::floorShift(j.iy0, L)),
-                         &j.points, &j.points_end);
+    for (detail::BlockJob& j : jobs) {
+      ndt_points.inBlock(
+          detail::blockKey(detail::floorShift(j.ix0, L), detail::floorShift(j.iy0, L)), &j.points,
+          &j.points_end);
       if (j.points != j.points_end && !j.block->ndt) {
         j.block->ndt = std::make_unique<detail::NdtCells>();
       }
@@ -173,7 +165,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
   std::atomic<std::size_t> next{0};
   if (threads <= 1) {
     detail::NodeStore store(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
-    return visited + updateBlocks<P>(impl, store, cls, pc, ndt, jobs, &next);
+    return visited + updateBlocksFor<P>(impl, store, cls, pc, ndt, jobs, &next);
   }
   orderByWork(ps, block_size, &jobs);
   if (!*workers || (*workers)->threads() != threadsFor(p)) {
@@ -192,7 +184,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     if (tu >= active) return;
     Tally& tally = tallies[tu];
     detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
-    tally.visited = updateBlocks<P>(impl, store, cls, pc, ndt, jobs, &next);
+    tally.visited = updateBlocksFor<P>(impl, store, cls, pc, ndt, jobs, &next);
   });
   for (const Tally& tally : tallies) {
     visited += tally.visited;

@@ -259,7 +259,10 @@ void writeNdt(const WaveletMap::Impl& impl, Writer* w) {
   std::vector<detail::NdtEntry> cells;
   for (const auto& kv : impl.blocks) {
     if (!kv.second.ndt || kv.second.ndt->empty()) continue;
-    cells = kv.second.ndt->entries;
+    cells.clear();
+    for (const detail::NdtEntry& e : kv.second.ndt->entries) {
+      if (detail::NdtCells::live(e)) cells.push_back(e);
+    }
     std::sort(cells.begin(), cells.end(),
               [](const detail::NdtEntry& a, const detail::NdtEntry& b) { return a.code < b.code; });
     w->put(static_cast<std::int32_t>(detail::blockKeyX(kv.first)));

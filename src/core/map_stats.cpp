@@ -36,7 +36,7 @@ MapStats WaveletMap::stats(bool count_observed) const {
   for (const auto& kv : impl.blocks) {
     const detail::NdtCells* ndt = kv.second.ndt.get();
     if (ndt == nullptr) continue;
-    st.ndt_cells += ndt->entries.size();
+    st.ndt_cells += ndt->entries.size() - ndt->dead;
     st.ndt_bytes += sizeof(detail::NdtCells) + ndt->entries.capacity() * sizeof(detail::NdtEntry);
   }
   st.bytes = impl.pool.bytes() + rest + st.ndt_bytes;

@@ -107,6 +107,7 @@ NdtLayer WaveletMap::exportNdt(int scale, const CellBox& window) const {
       continue;
     }
     for (const NdtEntry& e : b.ndt->entries) {
+      if (!detail::NdtCells::live(e)) continue;
       std::uint32_t lx, ly;
       detail::mortonCell(e.code, &lx, &ly);
       const std::int64_t ix = detail::scaleUp(bx, L) + lx, iy = detail::scaleUp(by, L) + ly;
@@ -154,7 +155,7 @@ bool WaveletMap::ndtCell(const CellIndex& cell, NdtCell* out) const {
   const std::int64_t mask = (std::int64_t{1} << L) - 1;
   const NdtEntry* e = b->ndt->find(detail::mortonCode(static_cast<std::uint32_t>(cell.x & mask),
                                                       static_cast<std::uint32_t>(cell.y & mask)));
-  if (e == nullptr) return false;
+  if (e == nullptr || !detail::NdtCells::live(*e)) return false;
   const double r = impl.params.grid.resolution;
   MomentSum sum;
   sum.add(e->m, 0.0, 0.0);

@@ -1,9 +1,10 @@
 // The storage of normal-distribution cells (MapParams::ndt): each block keeps the Gaussians of its
 // finest cells as moments in a vector, most of it sorted by the cells' Morton codes within the
-// block (so the cells under any quadtree node are one contiguous run), the latest new cells in an
-// unsorted tail that is merged in when it grows. Moments are sums of weighted end-points in
-// coordinates relative to the cell's centre, in double: a cell's covariance comes out without
-// the cancellation of map-frame moments. Not installed; included only by src/core/*.
+// block (so the cells under any quadtree node are one contiguous run of each of its two sorted
+// runs), the latest new cells in a short second run that is merged in when it grows. Moments are
+// sums of weighted end-points in coordinates relative to the cell's centre, in double: a cell's
+// covariance comes out without the cancellation of map-frame moments. Not installed; included only
+// by src/core/*.
 #ifndef WAVOG_MAPPING_SRC_CORE_NDT_STORE_H_
 #define WAVOG_MAPPING_SRC_CORE_NDT_STORE_H_
 
@@ -16,8 +17,8 @@ namespace detail {
 
 /// The moments of one finest cell's end-points (weights w_i, offsets (x_i, y_i) from the centre).
 struct NdtMoments {
-  double w = 0.0;                      ///< sum w_i
-  double sx = 0.0, sy = 0.0;           ///< sum w_i x_i, sum w_i y_i
+  double w = 0.0;                          ///< sum w_i
+  double sx = 0.0, sy = 0.0;               ///< sum w_i x_i, sum w_i y_i
   double sxx = 0.0, sxy = 0.0, syy = 0.0;  ///< sum w_i x_i^2, sum w_i x_i y_i, sum w_i y_i^2
 
   void scale(double f) {
@@ -44,47 +45,61 @@ struct NdtEntry {
   NdtMoments m;
 };
 
-/// A block's Gaussians: entries [0, sorted) ascend by code, the rest is the unsorted tail.
+/// A block's Gaussians: two runs ascending by code, entries [0, sorted) and the short tail after
+/// them that takes new cells (merged into the first run when it outgrows twice the square root of
+/// it, so a new cell costs amortised O(sqrt(n)) moves). A dropped Gaussian stays as an entry of
+/// weight 0 (live() is false) until dead ones are a quarter of the entries.
 struct NdtCells {
   std::vector<NdtEntry> entries;
   std::size_t sorted = 0;
+  std::size_t dead = 0;
 
-  bool empty() const { return entries.empty(); }
-  /// The entry of `code`, or nullptr.
-  const NdtEntry* find(std::uint32_t code) const {
-    return const_cast<NdtCells*>(this)->find(code);
-  }
+  static bool live(const NdtEntry& e) { return e.m.w > 0.0; }
+  bool empty() const { return entries.size() == dead; }
+  /// The entry of `code` (live or dead), or nullptr.
+  const NdtEntry* find(std::uint32_t code) const { return const_cast<NdtCells*>(this)->find(code); }
   NdtEntry* find(std::uint32_t code) {
-    const auto end = entries.begin() + static_cast<std::ptrdiff_t>(sorted);
-    const auto it = std::lower_bound(entries.begin(), end, code,
-                                     [](const NdtEntry& e, std::uint32_t c) { return e.code < c; });
-    if (it != end && it->code == code) return &*it;
-    for (auto t = end; t != entries.end(); ++t) {
-      if (t->code == code) return &*t;
-    }
-    return nullptr;
+    NdtEntry* e = findIn(entries.data(), entries.data() + sorted, code);
+    return e != nullptr ? e
+                        : findIn(entries.data() + sorted, entries.data() + entries.size(), code);
   }
-  /// Sorts the tail into the sorted part when it is longer than kTail and an eighth of it, so
-  /// that lookups stay cheap and a new cell costs amortised O(1) moves.
+  /// The entry of `code`, made empty in the tail if there is none.
+  NdtEntry& findOrInsert(std::uint32_t code) {
+    NdtEntry* e = find(code);
+    if (e != nullptr) return *e;
+    const auto pos =
+        std::upper_bound(entries.begin() + static_cast<std::ptrdiff_t>(sorted), entries.end(), code,
+                         [](std::uint32_t c, const NdtEntry& x) { return c < x.code; });
+    ++dead;  // empty until its first end-point is added
+    return *entries.insert(pos, NdtEntry{code, {}});
+  }
+  /// Merges the tail into the first run when it is longer than 2 sqrt(sorted) and kTail.
   void mergeTailIfLong() {
     const std::size_t tail = entries.size() - sorted;
-    if (tail <= kTail || tail * 8 <= sorted) return;
-    mergeTail();
-  }
-  void mergeTail() {
-    const auto mid = entries.begin() + static_cast<std::ptrdiff_t>(sorted);
+    if (tail <= kTail || tail * tail <= 4 * sorted) return;
     const auto by_code = [](const NdtEntry& a, const NdtEntry& b) { return a.code < b.code; };
-    std::sort(mid, entries.end(), by_code);
-    std::inplace_merge(entries.begin(), mid, entries.end(), by_code);
+    std::inplace_merge(entries.begin(), entries.begin() + static_cast<std::ptrdiff_t>(sorted),
+                       entries.end(), by_code);
     sorted = entries.size();
   }
-  /// Removes the entries for which drop(entry) is true, keeping both parts' order.
+  /// Drops the Gaussian of `e` (a live entry).
+  void drop(NdtEntry* e) {
+    e->m = NdtMoments{};
+    ++dead;
+  }
+  /// Removes the dead entries when they are a quarter of all.
+  void removeDeadIfMany() {
+    if (dead * 4 > entries.size() + kTail) removeIf([](const NdtEntry& e) { return !live(e); });
+  }
+  /// Removes the entries for which drop(entry) is true, keeping both runs' order.
   template <typename Drop>
   void removeIf(Drop drop) {
     std::size_t out = 0, sorted_out = 0;
+    dead = 0;
     for (std::size_t i = 0; i < entries.size(); ++i) {
       if (drop(entries[i])) continue;
       if (i < sorted) ++sorted_out;
+      dead += live(entries[i]) ? 0 : 1;
       entries[out++] = entries[i];
     }
     entries.resize(out);
@@ -93,6 +108,13 @@ struct NdtCells {
   }
 
   static constexpr std::size_t kTail = 32;
+
+ private:
+  static NdtEntry* findIn(NdtEntry* b, NdtEntry* e, std::uint32_t code) {
+    NdtEntry* it =
+        std::lower_bound(b, e, code, [](const NdtEntry& x, std::uint32_t c) { return x.code < c; });
+    return it != e && it->code == code ? it : nullptr;
+  }
 };
 
 /// Morton code of the cell at (lx, ly) within its block: x in the even bits, y in the odd ones,

@@ -1,9 +1,9 @@
 // The update of normal-distribution cells by one scan (MapParams::ndt): the scan's end-points
-// grouped by block (NdtScanPoints), and per block (updateNdtBlock) the policy on the Gaussians of
-// the cells the scan observes, found by a walk over the block's Morton-sorted cells against the
-// ScanClassifier (U squares skipped whole, E squares scaled whole, the rest cell by cell), then
-// the new end-points. It runs beside the quadtree update of the same block, on the same thread.
-// Not installed; included only by src/core/integrate.cpp.
+// grouped by block (NdtScanPoints), and per block (NdtBlockUpdate) the policy on the Gaussians:
+// the quadtree walk of the block (quadtree_update.h) carries the span of the entries under each
+// square it visits and forgets those the scan observes (U squares skip theirs, E squares forget
+// all of theirs, finest cells by their class), then the new end-points are added. Not installed;
+// included only by src/core/integrate.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_NDT_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_NDT_UPDATE_H_
 
@@ -37,12 +37,12 @@ class NdtScanPoints {
     const std::int64_t mask = (std::int64_t{1} << levels) - 1;
     for (std::size_t j = 0; j < n; ++j) {
       if (ps.kind[j] != BeamKind::kHit) continue;
-      double ex, ey;
-      ps.endpoint(j, &ex, &ey);
+      const double ex = ps.end_x[j], ey = ps.end_y[j];
       const std::int64_t ix = ps.hit_x[j], iy = ps.hit_y[j];
       NdtPoint p;
       p.block = blockKey(floorShift(ix, levels), floorShift(iy, levels));
-      p.code = mortonCode(static_cast<std::uint32_t>(ix & mask), static_cast<std::uint32_t>(iy & mask));
+      p.code =
+          mortonCode(static_cast<std::uint32_t>(ix & mask), static_cast<std::uint32_t>(iy & mask));
       p.beam = static_cast<std::uint32_t>(j);
       p.x = ex - (static_cast<double>(ix) + 0.5) * ps.res;
       p.y = ey - (static_cast<double>(iy) + 0.5) * ps.res;
@@ -57,8 +57,9 @@ class NdtScanPoints {
   bool empty() const { return points_.empty(); }
   /// The points of block `key`: [*first, *last).
   void inBlock(std::uint64_t key, const NdtPoint** first, const NdtPoint** last) const {
-    const auto lo = std::lower_bound(points_.begin(), points_.end(), key,
-                                     [](const NdtPoint& p, std::uint64_t k) { return p.block < k; });
+    const auto lo =
+        std::lower_bound(points_.begin(), points_.end(), key,
+                         [](const NdtPoint& p, std::uint64_t k) { return p.block < k; });
     auto hi = lo;
     while (hi != points_.end() && hi->block == key) ++hi;
     *first = points_.data() + (lo - points_.begin());
@@ -67,6 +68,42 @@ class NdtScanPoints {
 
  private:
   std::vector<NdtPoint> points_;
+};
+
+/// The entries of a block's two sorted runs under one square: [b1, e1) and [b2, e2).
+struct NdtSpan {
+  NdtEntry *b1 = nullptr, *e1 = nullptr, *b2 = nullptr, *e2 = nullptr;
+
+  bool empty() const { return b1 == e1 && b2 == e2; }
+  /// The entries under child q of the level-l square (their codes' bits 2(l-1), 2(l-1)+1 are q).
+  void split(int l, NdtSpan out[4]) const {
+    splitRun(b1, e1, l, &out[0].b1, &out[0].e1, &out[1].b1, &out[1].e1, &out[2].b1, &out[2].e1,
+             &out[3].b1, &out[3].e1);
+    splitRun(b2, e2, l, &out[0].b2, &out[0].e2, &out[1].b2, &out[1].e2, &out[2].b2, &out[2].e2,
+             &out[3].b2, &out[3].e2);
+  }
+  template <typename F>
+  void forEach(F f) const {
+    for (NdtEntry* x = b1; x != e1; ++x) f(x);
+    for (NdtEntry* x = b2; x != e2; ++x) f(x);
+  }
+
+ private:
+  static void splitRun(NdtEntry* b, NdtEntry* e, int l, NdtEntry** b0, NdtEntry** e0, NdtEntry** b1,
+                       NdtEntry** e1, NdtEntry** b2, NdtEntry** e2, NdtEntry** b3, NdtEntry** e3) {
+    const int shift = 2 * (l - 1);
+    const auto upto = [shift](unsigned q) {
+      return [shift, q](const NdtEntry& x) { return ((x.code >> shift) & 3u) <= q; };
+    };
+    NdtEntry* m0 = b == e ? e : std::partition_point(b, e, upto(0));
+    NdtEntry* m1 = m0 == e ? e : std::partition_point(m0, e, upto(1));
+    NdtEntry* m2 = m1 == e ? e : std::partition_point(m1, e, upto(2));
+    *b0 = b;
+    *e0 = *b1 = m0;
+    *e1 = *b2 = m1;
+    *e2 = *b3 = m2;
+    *e3 = e;
+  }
 };
 
 /// The policy on the Gaussians for one scan: an observed cell's moments times `a`, each new
@@ -78,104 +115,98 @@ struct NdtConsts {
   double min_weight = 0.0;
 };
 
+/// The update of one block's Gaussians by a scan, in three steps: begin() makes the cells of the
+/// scan's end-points (empty) and gives the span of all entries; the quadtree walk
+/// (Integrator<P, true>, quadtree_update.h) calls forget() on every entry whose cell the scan
+/// observes ("forget" only: forgets() is false otherwise); finish() adds the end-points, caps the
+/// weights and drops what is under the threshold.
 class NdtBlockUpdate {
  public:
-  NdtBlockUpdate(const ScanClassifier& cls, const NdtConsts& c, int levels)
-      : cls_(cls), c_(c), levels_(levels) {}
+  NdtBlockUpdate(const ScanClassifier& cls, const NdtConsts& c) : cls_(cls), c_(c) {}
 
-  /// Updates the Gaussians of the block at cell (ix0, iy0), classified as `box`, with the scan's
-  /// end-points [first, last) in it. Returns the cells visited.
-  std::uint64_t update(NdtCells& cells, std::int64_t ix0, std::int64_t iy0, const SquareInfo& box,
-                       const NdtPoint* first, const NdtPoint* last) {
+  /// True when an observation changes a Gaussian (the walk has to find the observed ones).
+  bool forgets() const { return c_.a != 1.0; }
+
+  /// Starts block (origin cell ix0, iy0) with its end-points [first, last); returns the span of
+  /// its entries.
+  NdtSpan begin(NdtCells& cells, std::int64_t ix0, std::int64_t iy0, const NdtPoint* first,
+                const NdtPoint* last) {
+    cells_ = &cells;
     ix0_ = ix0;
     iy0_ = iy0;
-    visited_ = 0;
-    low_ = false;
-    // New cells first, empty: the observation below leaves them empty.
+    first_ = first;
+    last_ = last;
+    low_.clear();
     for (const NdtPoint* p = first; p != last; ++p) {
-      if (p != first && p->code == p[-1].code) continue;
-      if (cells.find(p->code) == nullptr) cells.entries.push_back({p->code, {}});
+      if (p == first || p->code != p[-1].code) cells.findOrInsert(p->code);
     }
     cells.mergeTailIfLong();
-    if (c_.a != 1.0) {
-      NdtEntry* base = cells.entries.data();
-      observe(base, base + cells.sorted, levels_, ix0, iy0, box);
-      for (NdtEntry* e = base + cells.sorted; e != base + cells.entries.size(); ++e) {
-        observeCell(e, box);
-      }
+    // No entry is added or moved from here to finish().
+    NdtEntry* base = cells.entries.data();
+    base_ = base;
+    NdtSpan sp;
+    sp.b1 = base;
+    sp.e1 = sp.b2 = base + cells.sorted;
+    sp.e2 = base + cells.entries.size();
+    return sp;
+  }
+
+  /// The scan observes the cell of entry x (E or O).
+  void forget(NdtEntry* x) {
+    if (!NdtCells::live(*x)) return;
+    x->m.scale(c_.a);
+    if (!NdtCells::live(*x)) {
+      cells_->drop(x);  // underflow: nothing is left to keep
+    } else if (!(x->m.w >= c_.min_weight)) {
+      low_.push_back(static_cast<std::size_t>(x - base_));
     }
+  }
+  /// Every entry of `sp` (cells of a square classified as `box`) whose cell the scan observes.
+  void forgetObserved(const NdtSpan& sp, const SquareInfo& box) {
+    sp.forEach([&](NdtEntry* x) {
+      if (!NdtCells::live(*x)) return;
+      std::uint32_t lx, ly;
+      mortonCell(x->code, &lx, &ly);
+      const CellClass cls = cls_.classifyCell(ix0_ + lx, iy0_ + ly, box);
+      if (cls == CellClass::kEmpty || cls == CellClass::kOccupied) forget(x);
+    });
+  }
+
+  /// Adds the end-points, caps the weights, drops the Gaussians under the threshold.
+  void finish() {
+    NdtCells& cells = *cells_;
     NdtEntry* e = nullptr;
-    for (const NdtPoint* p = first; p != last; ++p) {
-      const bool same = p != first && p->code == p[-1].code;
-      if (!same) {
+    for (const NdtPoint* p = first_; p != last_; ++p) {
+      if (p == first_ || p->code != p[-1].code) {
         if (e != nullptr) settle(e);
         e = cells.find(p->code);
+        if (!NdtCells::live(*e)) --cells.dead;  // revived below
       }
       e->m.add(c_.g, p->x, p->y);
     }
     if (e != nullptr) settle(e);
-    if (low_) {
-      const double min_weight = c_.min_weight;
-      cells.removeIf([min_weight](const NdtEntry& x) { return !(x.m.w >= min_weight && x.m.w > 0.0); });
+    for (std::size_t i : low_) {
+      NdtEntry& x = cells.entries[i];
+      if (NdtCells::live(x) && !(x.m.w >= c_.min_weight)) cells.drop(&x);
     }
-    return visited_;
+    cells.removeDeadIfMany();
+    cells_ = nullptr;
   }
 
  private:
-  // Sorted entries [b, e) under the square of level l at (ix0, iy0) classified as `box`.
-  void observe(NdtEntry* b, NdtEntry* e, int l, std::int64_t ix0, std::int64_t iy0,
-               const SquareInfo& box) {
-    if (b == e || box.cls == CellClass::kUnknown) return;
-    ++visited_;
-    if (box.cls == CellClass::kEmpty) {
-      for (NdtEntry* x = b; x != e; ++x) forget(x);
-      return;
-    }
-    if (l <= 1 || e - b <= 2) {
-      for (NdtEntry* x = b; x != e; ++x) observeCell(x, box);
-      return;
-    }
-    const int shift = 2 * (l - 1);
-    const std::int64_t half = std::int64_t{1} << (l - 1);
-    NdtEntry* lo = b;
-    for (unsigned q = 0; q < 4; ++q) {
-      NdtEntry* hi = q == 3 ? e : std::partition_point(lo, e, [shift, q](const NdtEntry& x) {
-        return ((x.code >> shift) & 3u) <= q;
-      });
-      if (lo != hi) {
-        const std::int64_t cx = ix0 + ((q & 1u) ? half : 0), cy = iy0 + ((q & 2u) ? half : 0);
-        observe(lo, hi, l - 1, cx, cy, cls_.classifySquare(l - 1, cx, cy, box));
-      }
-      lo = hi;
-    }
-  }
-
-  // One entry of a square classified as `box`: forgotten when the scan observes its cell.
-  void observeCell(NdtEntry* x, const SquareInfo& box) {
-    ++visited_;
-    std::uint32_t lx, ly;
-    mortonCell(x->code, &lx, &ly);
-    const CellClass cls = cls_.classifyCell(ix0_ + lx, iy0_ + ly, box);
-    if (cls == CellClass::kEmpty || cls == CellClass::kOccupied) forget(x);
-  }
-
-  void forget(NdtEntry* x) {
-    x->m.scale(c_.a);
-    if (!(x->m.w >= c_.min_weight && x->m.w > 0.0)) low_ = true;
-  }
-
   // A cell that took end-points: the cap, and the drop test.
   void settle(NdtEntry* x) {
     if (x->m.w > c_.cap) x->m.scale(c_.cap / x->m.w);
-    if (!(x->m.w >= c_.min_weight && x->m.w > 0.0)) low_ = true;
+    if (!(x->m.w >= c_.min_weight)) low_.push_back(static_cast<std::size_t>(x - base_));
   }
 
   const ScanClassifier& cls_;
   const NdtConsts c_;
-  const int levels_;
+  NdtCells* cells_ = nullptr;       // the block's, from begin() to finish()
+  const NdtEntry* base_ = nullptr;  // its entries
   std::int64_t ix0_ = 0, iy0_ = 0;
-  std::uint64_t visited_ = 0;
-  bool low_ = false;
+  const NdtPoint *first_ = nullptr, *last_ = nullptr;
+  std::vector<std::size_t> low_;  // entries under the threshold after their forgetting
 };
 
 }  // namespace detail

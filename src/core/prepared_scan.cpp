@@ -136,6 +136,8 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
   hits.clear();
   hit_x.assign(nu, 0);
   hit_y.assign(nu, 0);
+  end_x.resize(nu);  // written for the hit beams below
+  end_y.resize(nu);
   reach = 0.0;
   for (std::size_t j = 0; j < nu; ++j) {
     const double z = ranges_[j];
@@ -154,8 +156,10 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
       kind[j] = BeamKind::kHit;
       ze = z - half_band;
       zu = z + half_band;
-      double ex, ey;
-      endpoint(j, &ex, &ey);
+      const double bearing = theta + (amin + static_cast<double>(j) * inc);
+      const double ex = px + z * std::cos(bearing), ey = py + z * std::sin(bearing);
+      end_x[j] = ex;
+      end_y[j] = ey;
       hit_x[j] = static_cast<std::int64_t>(std::floor(ex / res));
       hit_y[j] = static_cast<std::int64_t>(std::floor(ey / res));
       hits.push_back(cellKey(hit_x[j], hit_y[j]));
@@ -200,6 +204,8 @@ void PreparedScan::releaseIfLarge() {
   release(kind);
   release(leaf);
   release(hit_x);
+  release(end_x);
+  release(end_y);
   release(hit_y);
   release(hits);
   release(invalid_prefix);

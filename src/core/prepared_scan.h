@@ -55,6 +55,7 @@ struct PreparedScan {
   std::vector<BeamKind> kind;              ///< per beam
   std::vector<LeafTest> leaf;              ///< per beam: exact leaf thresholds
   std::vector<std::int64_t> hit_x, hit_y;  ///< per beam: the cell of its endpoint (hit beams)
+  std::vector<double> end_x, end_y;        ///< per beam: its endpoint, map frame (hit beams)
   std::vector<std::uint64_t> hits;         ///< sorted cellKey()s of the hit endpoints
   std::vector<int> invalid_prefix;         ///< invalid_prefix[j] = invalid beams in [0, j)
   /// Min of the squared E limits and max of the squared U limits over [j, j + 2^k), level-major
@@ -82,13 +83,6 @@ struct PreparedScan {
   bool anyInvalid(int lo, int hi) const {
     return invalid_prefix[static_cast<std::size_t>(hi) + 1] >
            invalid_prefix[static_cast<std::size_t>(lo)];
-  }
-  /// The map-frame end-point of hit beam j, computed as for its cell (hit_x, hit_y).
-  void endpoint(std::size_t j, double* ex, double* ey) const {
-    const double z = ranges_[j];
-    const double bearing = theta + (amin + static_cast<double>(j) * inc);
-    *ex = px + z * std::cos(bearing);
-    *ey = py + z * std::sin(bearing);
   }
   /// True if beam j is a hit whose endpoint lies in cell (ix, iy).
   bool hitsCell(std::size_t j, std::int64_t ix, std::int64_t iy) const {

@@ -1,16 +1,19 @@
 // The quadtree update of one scan (ALGORITHM.md sections 3 and 6): Integrator<P> walks a block
 // coarse to fine against the ScanClassifier's classes. U is skipped, E is applied at the slot's
 // own scale (a lazy tag with forgetting), the rest descends; the children's average changes fold
-// into the parent's details with one forward Haar step. Not installed; included only by
-// src/core/integrate.cpp.
+// into the parent's details with one forward Haar step. With kNdt (MapParams::ndt and "forget")
+// the walk also carries the span of the block's Gaussians under each square and forgets those the
+// scan observes (ndt_update.h). Not installed; included only by src/core/integrate.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #include "map_slot.h"
+#include "ndt_update.h"
 #include "scan_classifier.h"
 #include "update_policy.h"
 #include "wavog_mapping/core/haar.h"
@@ -18,21 +21,41 @@
 namespace wavog {
 namespace detail {
 
-template <PolicyType P>
+/// The spans of a node's four children: without Gaussians, nothing (every child reads the empty
+/// span), so that the walk without them is the walk it always was.
+struct NoSpans {
+  const NdtSpan& operator[](std::size_t) const {
+    static const NdtSpan kNone{};
+    return kNone;
+  }
+};
+
+template <PolicyType P, bool kNdt = false>
 class Integrator {
+  using Spans = std::conditional_t<kNdt, std::array<NdtSpan, 4>, NoSpans>;
+
  public:
-  /// Node groups come from and go to `store` (one Integrator per thread).
+  /// Node groups come from and go to `store` (one Integrator per thread); with kNdt, the
+  /// Gaussians' forgetting goes to `ndt`.
   Integrator(WaveletMap::Impl& impl, NodeStore& store, const ScanClassifier& classifier,
-             const PolicyConsts& pc)
-      : impl_(impl), store_(store), cls_(classifier), pc_(pc), lazy_(impl.params.lazy_forgetting) {}
+             const PolicyConsts& pc, NdtBlockUpdate* ndt = nullptr)
+      : impl_(impl),
+        store_(store),
+        cls_(classifier),
+        pc_(pc),
+        lazy_(impl.params.lazy_forgetting),
+        ndt_(ndt) {}
 
   /// Tree nodes and finest cells visited so far.
   std::uint64_t visited() const { return visited_; }
 
-  /// Updates block `b` (origin cell ix0, iy0) classified as `box`.
-  void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) {
+  /// Updates block `b` (origin cell ix0, iy0) classified as `box`; with kNdt, `sp` spans its
+  /// Gaussians.
+  void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, const SquareInfo& box,
+                      const NdtSpan& sp = NdtSpan{}) {
     RootSlot slot(impl_, store_, b);
     const double s = b.s;
+    if constexpr (kNdt) enterSlot(sp, box);
     b.s += updateSlot(slot, box.cls, s,
                       [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
   }
@@ -41,7 +64,9 @@ class Integrator {
   // The rules of one slot of class `cls` whose average is s (U skipped, E at the slot's own
   // scale, the section 3.4 skip); descend(m) updates the slot's node m (the stored one, or a
   // temporary uniform one) when the slot must be refined, and returns the change of its average.
-  // Returns the change of the slot's average.
+  // With kNdt, slot_span_ spans the Gaussians under the slot and slot_box_ is a square
+  // classification holding it (for its cells' classes), set by enterSlot(). Returns the change of
+  // the slot's average.
   template <typename Slot, typename Descend>
   [[gnu::always_inline]] double updateSlot(Slot& slot, CellClass cls, double s, Descend descend) {
     Node* node = slot.node();
@@ -50,10 +75,12 @@ class Integrator {
         return 0.0;
       case CellClass::kEmpty:
         if (node == nullptr) {  // uniform block: exact for every policy
+          if constexpr (kNdt) forgetSlot();
           slot.setKnown(true, true);
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
         }
         if (kAffineEmpty<P> && node->known_all == 0xF) {
+          if constexpr (kNdt) forgetSlot();
           if constexpr (P == PolicyType::kForget) forgetSubtree(slot, node);
           slot.setKnown(true, true);
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
@@ -63,6 +90,9 @@ class Integrator {
         // ALGORITHM.md 3.4: the E part would not change a uniform, fully known block.
         if (node == nullptr && slot.knownAll() &&
             std::fabs(applyPolicy<P>(pc_, CellClass::kEmpty, s) - s) <= pc_.unchanged_tol) {
+          if constexpr (kNdt) {
+            if (!slot_span_.empty()) ndt_->forgetObserved(slot_span_, *slot_box_);
+          }
           return 0.0;
         }
         break;
@@ -70,6 +100,16 @@ class Integrator {
         break;
     }
     return refineSlot(slot, node, descend);
+  }
+
+  // kNdt: the next slot to update spans `sp`, inside the square classified as `box`.
+  void enterSlot(const NdtSpan& sp, const SquareInfo& box) {
+    slot_span_ = sp;
+    slot_box_ = &box;
+  }
+  // kNdt: the scan observes every cell of the slot.
+  void forgetSlot() {
+    slot_span_.forEach([this](NdtEntry* x) { ndt_->forget(x); });
   }
 
   // The multiplicative part of an E update of a fully known subtree with forgetting: a lazy tag
@@ -96,6 +136,8 @@ class Integrator {
     if (l == 2 && ScanClassifier::fewSectors(box)) return visitLevel2(n, box, ix0, iy0, s);
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
+    Spans parts{};
+    if constexpr (kNdt) slot_span_.split(l, parts.data());
     const std::int64_t half = std::int64_t{1} << (l - 1);
     for (int q = 0; q < 4; ++q) {
       const auto qu = static_cast<std::size_t>(q);
@@ -104,6 +146,7 @@ class Integrator {
       ++visited_;
       if (child_box.cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
+      if constexpr (kNdt) enterSlot(parts[qu], child_box);
       delta[qu] = updateSlot(slot, child_box.cls, c[qu], [&](Node& m) {
         return visitNode(m, child_box, l - 1, cx, cy, c[qu]);
       });
@@ -125,9 +168,16 @@ class Integrator {
   }
 
   // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), cell q
-  // E or O by bit q of `cells` (U when in neither); returns the change of n's average.
+  // E or O by bit q of `cells` (U when in neither), and to the Gaussians of those cells (the
+  // slot's span); returns the change of n's average.
   double updateCells(Node& n, const CellMasks& cells, double s) {
     visited_ += 4;
+    if constexpr (kNdt) {
+      const std::uint32_t observed = cells.e | cells.o;
+      slot_span_.forEach([&](NdtEntry* x) {
+        if ((observed >> (x->code & 3u)) & 1u) ndt_->forget(x);
+      });
+    }
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     for (std::size_t q = 0; q < 4; ++q) {
@@ -146,10 +196,13 @@ class Integrator {
   // A level-2 node (4 x 4 finest cells, tag flushed): its 16 cells are classified together
   // (cheaply when the square lies in one or a few sectors) and each level-1 child slot takes the
   // class of its 4 cells, exactly, instead of a conservative square test of its own.
-  double visitLevel2(Node& n, const SquareInfo& box, std::int64_t ix0, std::int64_t iy0, double s) {
+  [[gnu::noinline]] double visitLevel2(Node& n, const SquareInfo& box, std::int64_t ix0,
+                                       std::int64_t iy0, double s) {
     const CellMasks cells = cls_.classify4x4(ix0, iy0, box);  // cell (x, y) at bit x + 4 y
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
+    Spans parts{};
+    if constexpr (kNdt) slot_span_.split(2, parts.data());
     for (int q = 0; q < 4; ++q) {
       ++visited_;
       const auto qu = static_cast<std::size_t>(q);
@@ -159,6 +212,7 @@ class Integrator {
       const CellClass cls = slotClass(cc);
       if (cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
+      if constexpr (kNdt) enterSlot(parts[qu], box);
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
@@ -194,6 +248,11 @@ class Integrator {
   const ScanClassifier& cls_;
   const PolicyConsts pc_;
   const bool lazy_;
+  NdtBlockUpdate* const ndt_;
+  // kNdt: the Gaussians under the slot being updated and a classification holding it. A visit
+  // reads them on entry (children set them again, one after the other).
+  NdtSpan slot_span_;
+  const SquareInfo* slot_box_ = nullptr;
   std::uint64_t visited_ = 0;
 };
 

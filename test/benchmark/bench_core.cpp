@@ -85,17 +85,20 @@ enum Variant {
   kForgetEager = 2,
   kClampReflection = 3,  // with the reflection layers (MapParams::reflection)
   kForgetReflection = 4,
+  kClampNdt = 5,  // with normal-distribution cells (MapParams::ndt)
+  kForgetNdt = 6,
 };
-const char* kVariantNames[] = {"clamp", "forget_lazy", "forget_eager", "clamp+reflection",
-                               "forget_lazy+reflection"};
+const char* kVariantNames[] = {"clamp",      "forget_lazy",     "forget_eager", "clamp+reflection",
+                               "forget_lazy+reflection", "clamp+ndt", "forget_lazy+ndt"};
 
 MapParams paramsFor(Variant v, double res, double tau) {
-  const bool clamp = v == kClamp || v == kClampReflection;
+  const bool clamp = v == kClamp || v == kClampReflection || v == kClampNdt;
   MapParams p = MapParams::defaultsFor(clamp ? PolicyType::kClamp : PolicyType::kForget);
   p.grid.resolution = res;
   p.lazy_forgetting = v != kForgetEager;
   p.prune_threshold = tau;
   p.reflection = v == kClampReflection || v == kForgetReflection;
+  p.ndt = v == kClampNdt || v == kForgetNdt;
   return p;
 }
 
@@ -224,13 +227,16 @@ void printSummary() {
                   m(base + "clamp") / m(base + "forget_lazy"));
       std::printf("%-20s lazy / eager speed           = %.2f (target >= 3 on 80 m)\n", (std::string(wl) + "@" + res).c_str(),
                   m(base + "forget_lazy") / m(base + "forget_eager"));
-      for (const char* v : {"clamp", "forget_lazy"}) {
-        const std::string with = base + v + "+reflection";
-        if (!g_rates.count(with)) continue;
-        std::printf("%-20s %-11s reflection cost / occupancy alone = %.2f (target <= 1.3), bytes/cell "
-                    "%.3f -> %.3f\n",
-                    (std::string(wl) + "@" + res).c_str(), v, m(base + v) / m(with),
-                    g_figures[base + v].bytes_per_cell, g_figures[with].bytes_per_cell);
+      for (const char* payload : {"reflection", "ndt"}) {
+        const double target = std::string(payload) == "ndt" ? 1.5 : 1.3;
+        for (const char* v : {"clamp", "forget_lazy"}) {
+          const std::string with = base + v + "+" + payload;
+          if (!g_rates.count(with)) continue;
+          std::printf("%-20s %-11s %-10s cost / occupancy alone = %.2f (target <= %.1f), "
+                      "bytes/cell %.3f -> %.3f\n",
+                      (std::string(wl) + "@" + res).c_str(), v, payload, m(base + v) / m(with),
+                      target, g_figures[base + v].bytes_per_cell, g_figures[with].bytes_per_cell);
+        }
       }
     }
   }
@@ -285,8 +291,9 @@ void printSummary() {
 int main(int argc, char** argv) {
   for (const char* wl : {"fr079", "synthetic80m"}) {
     for (double res : {0.05, 0.10}) {
-      for (Variant v : {kClamp, kForgetLazy, kForgetEager, kClampReflection, kForgetReflection}) {
-        if (res != 0.05 && (v == kClampReflection || v == kForgetReflection)) continue;
+      for (Variant v : {kClamp, kForgetLazy, kForgetEager, kClampReflection, kForgetReflection,
+                        kClampNdt, kForgetNdt}) {
+        if (res != 0.05 && v != kClamp && v != kForgetLazy && v != kForgetEager) continue;
         const std::string name = std::string("integrate/") + wl + "/" +
                                  std::to_string(static_cast<int>(std::lround(res * 100))) + "cm/" + kVariantNames[v];
         benchmark::RegisterBenchmark(name.c_str(), BM_Integrate, std::string(wl), res, v)

@@ -208,8 +208,9 @@ void DenseReference::integrateNdt(const ReferenceClassifier& ref, const wavog::P
   std::set<std::pair<std::int64_t, std::int64_t>> touched;
   const double res = p.grid.resolution;
   for (const auto& e : points) {
-    const std::pair<std::int64_t, std::int64_t> key{static_cast<std::int64_t>(std::floor(e.second / res)),
-                                                    static_cast<std::int64_t>(std::floor(e.first / res))};
+    const std::pair<std::int64_t, std::int64_t> key{
+        static_cast<std::int64_t>(std::floor(e.second / res)),
+        static_cast<std::int64_t>(std::floor(e.first / res))};
     Moments& m = ndt_[key];
     m.w += g;
     m.x += g * e.first;
@@ -260,7 +261,8 @@ std::vector<wavog::NdtCell> DenseReference::ndtLayer(int s, const wavog::CellBox
   std::map<std::pair<std::int64_t, std::int64_t>, Moments> merged;
   for (const auto& kv : ndt_) {
     const std::int64_t cx = kv.first.second >> s, cy = kv.first.first >> s;
-    if (cx < window.min_x || cx >= window.max_x || cy < window.min_y || cy >= window.max_y) continue;
+    if (cx < window.min_x || cx >= window.max_x || cy < window.min_y || cy >= window.max_y)
+      continue;
     Moments& m = merged[{cy, cx}];
     m.w += kv.second.w;
     m.x += kv.second.x;

@@ -98,8 +98,8 @@ TEST(Ndt, RandomScansEveryPolicyAndPriorEveryScale) {
   for (int levels : {3, 5}) {
     for (PolicyType type : everyPolicyType()) {
       for (wavog::InitValue init : {wavog::InitValue::kUnknown, wavog::InitValue::kEmptyBound}) {
-        const std::string name = std::string(wavog::toString(type)) + " " +
-                                 wavog::toString(init) + " L" + std::to_string(levels);
+        const std::string name = std::string(wavog::toString(type)) + " " + wavog::toString(init) +
+                                 " L" + std::to_string(levels);
         SCOPED_TRACE(name);
         MapParams p = ndtParams(type, res, levels);
         p.policy.init = init;
@@ -158,6 +158,29 @@ TEST(Ndt, ForgettingWithPerScanRates) {
   expectSameNdt(map, ref, 5, "forget_half_life");
 }
 
+// Pruning, the skip of unchanged free squares (ALGORITHM.md 3.4) and eager forgetting change how
+// the tree walks, not which Gaussians the scan observes: they stay exact.
+TEST(Ndt, ExactUnderPruningSkipsAndEagerForgetting) {
+  for (int variant = 0; variant < 2; ++variant) {
+    MapParams p = ndtParams(PolicyType::kForget, 0.1, 5);
+    if (variant == 0) {
+      p.prune_threshold = 0.05;
+      p.skip_tolerance = 0.01;
+    } else {
+      p.lazy_forgetting = false;
+    }
+    WaveletMap map(p);
+    DenseReference ref(p, CellBox{-120, -120, 120, 120});
+    RandomScans scans(7u + static_cast<unsigned>(variant), 12.0);
+    for (int i = 0; i < 200; ++i) {
+      const OwnedScan s = scans.next();
+      map.integrate(s.pose, s.view());
+      ref.integrate(s.pose, s.view());
+    }
+    expectSameNdt(map, ref, 5, variant == 0 ? "pruned, skipping" : "eager");
+  }
+}
+
 // A wall seen from afar: the Gaussians of its cells lie on it, thin across it; once the wall is
 // gone (the beams pass through), forgetting drops them.
 TEST(Ndt, WallGaussiansAndTheirForgetting) {
@@ -167,8 +190,8 @@ TEST(Ndt, WallGaussiansAndTheirForgetting) {
   const int n = 181;
   const double amin = -M_PI / 6, inc = (M_PI / 3) / (n - 1);
   std::vector<float> wall(n), gone(n, 20.0f);
-  for (int j = 0; j < n; ++j) wall[static_cast<std::size_t>(j)] =
-      static_cast<float>(3.03 / std::cos(amin + inc * j));
+  for (int j = 0; j < n; ++j)
+    wall[static_cast<std::size_t>(j)] = static_cast<float>(3.03 / std::cos(amin + inc * j));
   OwnedScan s;
   s.pose = {0.0, 0.0, 0.0};
   s.angle_min = amin;
@@ -187,14 +210,14 @@ TEST(Ndt, WallGaussiansAndTheirForgetting) {
   }
   // The wall is gone: the beams end at a wall 8 m away, every former wall cell is now E.
   const auto near_wall = [&map] {
-    std::size_t n = 0;
+    std::size_t count = 0;
     for (const NdtCell& c : map.exportNdt(0, CellBox{-100, -100, 100, 100}).cells) {
-      n += c.mean_x < 5.0 ? 1 : 0;
+      count += c.mean_x < 5.0 ? 1 : 0;
     }
-    return n;
+    return count;
   };
-  for (int j = 0; j < n; ++j) gone[static_cast<std::size_t>(j)] =
-      static_cast<float>(8.0 / std::cos(amin + inc * j));
+  for (int j = 0; j < n; ++j)
+    gone[static_cast<std::size_t>(j)] = static_cast<float>(8.0 / std::cos(amin + inc * j));
   s.ranges = gone;
   map.integrate(s.pose, s.view());
   EXPECT_EQ(near_wall(), layer.cells.size()) << "one observation forgets, it does not drop";
@@ -281,7 +304,8 @@ TEST(Ndt, FilesAndClearing) {
   EXPECT_LT(after.cells.size(), before);
   EXPECT_GT(after.cells.size(), 0u);
   for (const NdtCell& c : after.cells) {
-    const double x = (static_cast<double>(c.ix) + 0.5) * 0.1, y = (static_cast<double>(c.iy) + 0.5) * 0.1;
+    const double x = (static_cast<double>(c.ix) + 0.5) * 0.1,
+                 y = (static_cast<double>(c.iy) + 0.5) * 0.1;
     EXPECT_FALSE(x >= -2.0 && x <= 2.0 && y >= -2.0 && y <= 2.0) << c.ix << ", " << c.iy;
   }
   map.reset();

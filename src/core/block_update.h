@@ -1,0 +1,57 @@
+// The update of one scan's blocks (integrate.cpp): the list of blocks a scan touches and the loop
+// that takes them one by one (from a counter shared by the threads of the scan) through the
+// quadtree update Integrator<P, kNdt> and, with MapParams::ndt, the update of their Gaussians.
+// Not installed; included only by src/core/integrate*.cpp.
+#ifndef WAVOG_MAPPING_SRC_CORE_BLOCK_UPDATE_H_
+#define WAVOG_MAPPING_SRC_CORE_BLOCK_UPDATE_H_
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "map_impl.h"
+#include "ndt_update.h"
+#include "quadtree_update.h"
+
+namespace wavog {
+namespace detail {
+
+// One block of the scan: its storage, origin cell and class, and its end-points (MapParams::ndt).
+struct BlockJob {
+  Block* block;
+  std::int64_t ix0, iy0;
+  SquareInfo box;
+  const NdtPoint *points = nullptr, *points_end = nullptr;
+};
+
+// Updates the blocks jobs[i] for the indices i taken from `next` (shared by the threads of one
+// scan); node groups from `store`; with `ndt`, their Gaussians too (the walk finds the observed
+// ones when the policy forgets them: kNdt). Returns the nodes visited. The one place Integrator
+// is made, so the hot code is compiled once per policy (and once more with the Gaussians).
+template <PolicyType P, bool kNdt>
+[[gnu::noinline]] std::uint64_t updateBlocks(WaveletMap::Impl& impl, NodeStore& store,
+                                             const ScanClassifier& cls, const PolicyConsts& pc,
+                                             const NdtConsts* ndt,
+                                             const std::vector<BlockJob>& jobs,
+                                             std::atomic<std::size_t>* next) {
+  NdtBlockUpdate ndt_update(cls, ndt != nullptr ? *ndt : NdtConsts{});
+  Integrator<P, kNdt> integrator(impl, store, cls, pc, &ndt_update);
+  for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < jobs.size();
+       i = next->fetch_add(1, std::memory_order_relaxed)) {
+    const BlockJob& j = jobs[i];
+    store.useSpare(&j.block->spare);
+    if (ndt == nullptr || !j.block->ndt) {
+      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
+      continue;
+    }
+    const NdtSpan sp = ndt_update.begin(*j.block->ndt, j.ix0, j.iy0, j.points, j.points_end);
+    integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box, kNdt ? sp : NdtSpan{});
+    ndt_update.finish();
+  }
+  return integrator.visited();
+}
+
+}  // namespace detail
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_SRC_CORE_BLOCK_UPDATE_H_
