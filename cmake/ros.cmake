@@ -69,6 +69,11 @@ if(CATKIN_ENABLE_TESTING)
     if(TARGET test_seq_gaps)
       target_link_libraries(test_seq_gaps wavog_ros ${GTEST_MAIN_LIBRARIES})
     endif()
+    # The NDT layers as MarkerArray and PointCloud2 (issue 14).
+    catkin_add_gtest(test_ndt_conversions test/ros/test_ndt_conversions.cpp)
+    if(TARGET test_ndt_conversions)
+      target_link_libraries(test_ndt_conversions wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
     # The node's limits (issue 16): time checks, publication sizing, save_map below map_dir.
     catkin_add_gtest(test_node_limits test/ros/test_node_limits.cpp)
     if(TARGET test_node_limits)
