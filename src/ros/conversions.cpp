@@ -263,20 +263,24 @@ sensor_msgs::PointCloud2::Ptr toNdtCloud(const wavog::NdtLayer& layer, const std
   msg->height = 1;  // unorganised: resize() then sets the width
   sensor_msgs::PointCloud2Modifier modifier(*msg);
   using sensor_msgs::PointField;
-  modifier.setPointCloud2Fields(7, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32,
-                                "cov_xx", 1, PointField::FLOAT32, "cov_xy", 1,
-                                PointField::FLOAT32, "cov_yy", 1, PointField::FLOAT32, "weight",
-                                1, PointField::FLOAT32, "occupancy", 1, PointField::FLOAT32);
+  // z (0: the map plane) is not NDT data: rviz draws, and PCL reads, only clouds with x, y and z.
+  modifier.setPointCloud2Fields(8, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32, "z", 1,
+                                PointField::FLOAT32, "cov_xx", 1, PointField::FLOAT32, "cov_xy",
+                                1, PointField::FLOAT32, "cov_yy", 1, PointField::FLOAT32,
+                                "weight", 1, PointField::FLOAT32, "occupancy", 1,
+                                PointField::FLOAT32);
   modifier.resize(layer.cells.size());
   msg->is_dense = true;
   // One iterator per field, in the order above.
-  const char* const kFields[7] = {"x", "y", "cov_xx", "cov_xy", "cov_yy", "weight", "occupancy"};
+  constexpr std::size_t kFields = 8;
+  const char* const kNames[kFields] = {"x",      "y",      "z",      "cov_xx",
+                                       "cov_xy", "cov_yy", "weight", "occupancy"};
   std::vector<sensor_msgs::PointCloud2Iterator<float>> it;
-  for (const char* f : kFields) it.emplace_back(*msg, f);
+  for (const char* f : kNames) it.emplace_back(*msg, f);
   for (const wavog::NdtCell& c : layer.cells) {
-    const double values[7] = {c.mean_x, c.mean_y, c.cov_xx, c.cov_xy,
-                              c.cov_yy, c.weight, occupancyProbability(c.log_odds)};
-    for (std::size_t f = 0; f < 7; ++f) {
+    const double values[kFields] = {c.mean_x, c.mean_y, 0.0,      c.cov_xx,
+                                    c.cov_xy, c.cov_yy, c.weight, occupancyProbability(c.log_odds)};
+    for (std::size_t f = 0; f < kFields; ++f) {
       *it[f] = static_cast<float>(values[f]);
       ++it[f];
     }

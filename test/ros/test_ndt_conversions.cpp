@@ -1,6 +1,6 @@
 // The NDT conversions without a roscore: NdtLayer -> visualization_msgs/MarkerArray (a DELETEALL,
 // then one flat 2-sigma ellipse per Gaussian, coloured by occupancy) and -> sensor_msgs/PointCloud2
-// (fields x, y, cov_xx, cov_xy, cov_yy, weight, occupancy), read back through sensor_msgs'
+// (fields x, y, z, cov_xx, cov_xy, cov_yy, weight, occupancy), read back through sensor_msgs'
 // iterators.
 #include <gtest/gtest.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
@@ -173,15 +173,15 @@ TEST(NdtMarkers, EmptyLayerOnlyClears) {
   EXPECT_EQ(msg->markers[0].header.frame_id, "odom");
 }
 
-TEST(NdtCloud, SevenFloatFieldsReadBackByIterators) {
+TEST(NdtCloud, FloatFieldsReadBackByIterators) {
   const wavog::NdtLayer layer = sampleLayer();
   const auto msg = toNdtCloud(layer, "map", ros::Time(3.0));
   EXPECT_EQ(msg->header.frame_id, "map");
   EXPECT_EQ(msg->header.stamp, ros::Time(3.0));
   EXPECT_EQ(msg->height, 1u);
   EXPECT_EQ(msg->width, layer.cells.size());
-  const std::vector<std::string> names = {"x",      "y",      "cov_xx",   "cov_xy",
-                                          "cov_yy", "weight", "occupancy"};
+  const std::vector<std::string> names = {"x",      "y",      "z",      "cov_xx",
+                                          "cov_xy", "cov_yy", "weight", "occupancy"};
   ASSERT_EQ(msg->fields.size(), names.size());
   for (std::size_t f = 0; f < names.size(); ++f) {
     EXPECT_EQ(msg->fields[f].name, names[f]);
@@ -189,22 +189,24 @@ TEST(NdtCloud, SevenFloatFieldsReadBackByIterators) {
     EXPECT_EQ(msg->fields[f].count, 1u);
     EXPECT_EQ(msg->fields[f].offset, 4 * f);
   }
-  EXPECT_EQ(msg->point_step, 28u);
-  EXPECT_EQ(msg->row_step, 28u * layer.cells.size());
+  EXPECT_EQ(msg->point_step, 32u);
+  EXPECT_EQ(msg->row_step, 32u * layer.cells.size());
   EXPECT_EQ(msg->data.size(), msg->row_step);
   EXPECT_FALSE(msg->is_bigendian);
 
-  sensor_msgs::PointCloud2ConstIterator<float> x(*msg, "x"), y(*msg, "y"), xx(*msg, "cov_xx"),
-      xy(*msg, "cov_xy"), yy(*msg, "cov_yy"), w(*msg, "weight"), occ(*msg, "occupancy");
+  sensor_msgs::PointCloud2ConstIterator<float> x(*msg, "x"), y(*msg, "y"), z(*msg, "z"),
+      xx(*msg, "cov_xx"), xy(*msg, "cov_xy"), yy(*msg, "cov_yy"), w(*msg, "weight"),
+      occ(*msg, "occupancy");
   for (const wavog::NdtCell& c : layer.cells) {
     EXPECT_FLOAT_EQ(*x, static_cast<float>(c.mean_x));
     EXPECT_FLOAT_EQ(*y, static_cast<float>(c.mean_y));
+    EXPECT_EQ(*z, 0.0f);
     EXPECT_FLOAT_EQ(*xx, static_cast<float>(c.cov_xx));
     EXPECT_FLOAT_EQ(*xy, static_cast<float>(c.cov_xy));
     EXPECT_FLOAT_EQ(*yy, static_cast<float>(c.cov_yy));
     EXPECT_FLOAT_EQ(*w, static_cast<float>(c.weight));
     EXPECT_NEAR(*occ, 1.0 / (1.0 + std::exp(-static_cast<double>(c.log_odds))), 1e-6);
-    ++x, ++y, ++xx, ++xy, ++yy, ++w, ++occ;
+    ++x, ++y, ++z, ++xx, ++xy, ++yy, ++w, ++occ;
   }
   EXPECT_FALSE(x != x.end());
   // The wall is occupied, the free cell free, the single point halfway.
@@ -221,7 +223,7 @@ TEST(NdtCloud, EmptyLayerKeepsItsFields) {
   const auto msg = toNdtCloud(layer, "map", ros::Time(1.0));
   EXPECT_EQ(msg->width, 0u);
   EXPECT_EQ(msg->height, 1u);
-  EXPECT_EQ(msg->fields.size(), 7u);
+  EXPECT_EQ(msg->fields.size(), 8u);
   EXPECT_TRUE(msg->data.empty());
 }
 

@@ -126,8 +126,8 @@ visualization_msgs::MarkerArray::Ptr toNdtMarkers(const wavog::NdtLayer& layer,
                                                   const ros::Time& stamp);
 
 /// The NDT cells of one layer as an unorganised cloud (height 1, one point per Gaussian, the
-/// layer's order) with float32 fields x, y (the mean, m), cov_xx, cov_xy, cov_yy (m^2), weight
-/// and occupancy (P(occ) of the cell, 0..1), in `frame`.
+/// layer's order) with float32 fields x, y (the mean, m), z (0, so that rviz and PCL take it),
+/// cov_xx, cov_xy, cov_yy (m^2), weight and occupancy (P(occ) of the cell, 0..1), in `frame`.
 sensor_msgs::PointCloud2::Ptr toNdtCloud(const wavog::NdtLayer& layer, const std::string& frame,
                                          const ros::Time& stamp);
 
