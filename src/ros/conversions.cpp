@@ -265,10 +265,9 @@ sensor_msgs::PointCloud2::Ptr toNdtCloud(const wavog::NdtLayer& layer, const std
   using sensor_msgs::PointField;
   // z (0: the map plane) is not NDT data: rviz draws, and PCL reads, only clouds with x, y and z.
   modifier.setPointCloud2Fields(8, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32, "z", 1,
-                                PointField::FLOAT32, "cov_xx", 1, PointField::FLOAT32, "cov_xy",
-                                1, PointField::FLOAT32, "cov_yy", 1, PointField::FLOAT32,
-                                "weight", 1, PointField::FLOAT32, "occupancy", 1,
-                                PointField::FLOAT32);
+                                PointField::FLOAT32, "cov_xx", 1, PointField::FLOAT32, "cov_xy", 1,
+                                PointField::FLOAT32, "cov_yy", 1, PointField::FLOAT32, "weight", 1,
+                                PointField::FLOAT32, "occupancy", 1, PointField::FLOAT32);
   modifier.resize(layer.cells.size());
   msg->is_dense = true;
   // One iterator per field, in the order above.

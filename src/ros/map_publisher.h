@@ -2,8 +2,9 @@
 // around the robot or the whole map, and over the same boxes with MapParams::reflection the
 // `reflection` (latched) and reflection_scale_<s> layers, with MapParams::ndt the NDT cells as
 // ndt_markers / ndt_cells (latched) and ndt_markers_scale_<s> / ndt_cells_scale_<s>;
-// map_updates, the changed rectangle of the finest layer, from one dirty region. Reads happen under the caller's lock (MappingRos::Impl::mutex_,
-// which guards this object and the map); publish() and publishUpdate() run without it.
+// map_updates, the changed rectangle of the finest layer, from one dirty region. Reads happen under
+// the caller's lock (MappingRos::Impl::mutex_, which guards this object and the map); publish() and
+// publishUpdate() run without it.
 #ifndef WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
 #define WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
 

@@ -41,7 +41,8 @@ double wallDistance(double x, double y) {
 
 template <typename M>
 boost::shared_ptr<const M> fresh(const boost::shared_ptr<const M>* which) {
-  return room::waitLatest(&g_mutex, which, [](const M&) { return true; }, 10.0);
+  return room::waitLatest(
+      &g_mutex, which, [](const M&) { return true; }, 10.0);
 }
 
 /// The x, y, weight of a cloud's points, in its order.
@@ -248,10 +249,10 @@ int main(int argc, char** argv) {
   static_tf.sendTransform(room::staticTree());
   auto status_sub = room::keepLatest<wavog_mapping::MapperStatus>(nh, "wavog_mapping/status", 10,
                                                                   &g_mutex, &g_status);
-  auto markers_sub = room::keepLatest<visualization_msgs::MarkerArray>(nh, "ndt_markers", 2,
-                                                                       &g_mutex, &g_markers);
-  auto markers2_sub = room::keepLatest<visualization_msgs::MarkerArray>(
-      nh, "ndt_markers_scale_2", 2, &g_mutex, &g_markers_2);
+  auto markers_sub =
+      room::keepLatest<visualization_msgs::MarkerArray>(nh, "ndt_markers", 2, &g_mutex, &g_markers);
+  auto markers2_sub = room::keepLatest<visualization_msgs::MarkerArray>(nh, "ndt_markers_scale_2",
+                                                                        2, &g_mutex, &g_markers_2);
   auto cells_sub =
       room::keepLatest<sensor_msgs::PointCloud2>(nh, "ndt_cells", 2, &g_mutex, &g_cells);
   auto cells2_sub =

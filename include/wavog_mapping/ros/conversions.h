@@ -122,8 +122,7 @@ void ndtEllipse(double cov_xx, double cov_xy, double cov_yy, double* major, doub
 /// (ndtEllipse; each axis at least kNdtMinAxisCells x cell size), coloured from blue (P(occ) 0)
 /// to red (P(occ) 1) by the cell's occupancy.
 visualization_msgs::MarkerArray::Ptr toNdtMarkers(const wavog::NdtLayer& layer,
-                                                  const std::string& frame,
-                                                  const ros::Time& stamp);
+                                                  const std::string& frame, const ros::Time& stamp);
 
 /// The NDT cells of one layer as an unorganised cloud (height 1, one point per Gaussian, the
 /// layer's order) with float32 fields x, y (the mean, m), z (0, so that rviz and PCL take it),
