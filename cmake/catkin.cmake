@@ -2,7 +2,7 @@
 # dynamic_reconfigure, and catkin_package(). Owned by the ROS layer. Everything here comes before
 # the targets that use catkin variables.
 find_package(catkin REQUIRED COMPONENTS
-  roscpp nodelet pluginlib tf2 tf2_ros sensor_msgs nav_msgs geometry_msgs map_msgs
+  roscpp nodelet pluginlib tf2 tf2_ros sensor_msgs nav_msgs geometry_msgs map_msgs visualization_msgs
   std_msgs std_srvs diagnostic_updater diagnostic_msgs dynamic_reconfigure rosbag message_generation)
 find_package(yaml-cpp REQUIRED)
 
@@ -15,7 +15,7 @@ catkin_package(
   INCLUDE_DIRS include
   LIBRARIES wavog_core wavog_io wavog_ros_config
   CATKIN_DEPENDS roscpp nodelet pluginlib tf2 tf2_ros sensor_msgs nav_msgs geometry_msgs map_msgs
-                 std_msgs std_srvs diagnostic_updater diagnostic_msgs dynamic_reconfigure rosbag
+                 visualization_msgs std_msgs std_srvs diagnostic_updater diagnostic_msgs dynamic_reconfigure rosbag
                  message_runtime
   DEPENDS EIGEN3
 )

@@ -69,6 +69,11 @@ if(CATKIN_ENABLE_TESTING)
     if(TARGET test_seq_gaps)
       target_link_libraries(test_seq_gaps wavog_ros ${GTEST_MAIN_LIBRARIES})
     endif()
+    # The NDT layers as MarkerArray and PointCloud2 (issue 14).
+    catkin_add_gtest(test_ndt_conversions test/ros/test_ndt_conversions.cpp)
+    if(TARGET test_ndt_conversions)
+      target_link_libraries(test_ndt_conversions wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
     # The node's limits (issue 16): time checks, publication sizing, save_map below map_dir.
     catkin_add_gtest(test_node_limits test/ros/test_node_limits.cpp)
     if(TARGET test_node_limits)
@@ -112,6 +117,10 @@ if(CATKIN_ENABLE_TESTING)
       test/ros/test_half_life_rates.cpp)
     wavog_rostest_gtest(test_reflection_topics test/reflection_topics.test
       test/ros/test_reflection_topics.cpp)
+    # The NDT layers' topics (ndt: true), none without ndt, a bad ndt_min_weight at start-up.
+    wavog_rostest_gtest(test_ndt_topics test/ndt_topics.test test/ros/test_ndt_topics.cpp)
+    target_compile_definitions(test_ndt_topics PRIVATE
+      WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
     # Sim time jumping backwards (bag restart): tf buffer cleared, mapping goes on.
     wavog_rostest_gtest(test_clock_jump test/clock_jump.test test/ros/test_clock_jump.cpp)
 

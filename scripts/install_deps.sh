@@ -11,6 +11,7 @@ PKGS=(
   libtf2-ros-dev liblaser-geometry-dev libdiagnostic-updater-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libsensor-msgs-dev libnav-msgs-dev libstd-srvs-dev libmap-msgs-dev libgeometry-msgs-dev
+  libvisualization-msgs-dev
   librosbag-dev librosbag-storage-dev python3-rosbag python3-rostest python3-roslaunch
   python3-rosmaster python3-rostopic python3-rosnode python3-tf2-ros python3-rosgraph rosout
   python3-catkin-pkg python3-genmsg python3-gencpp python3-genpy libyaml-cpp-dev
@@ -21,6 +22,7 @@ PKGS=(
   # mapper's topics (Python message modules), the install-space test's map check.
   rosbash python3-rospy python3-rosservice python3-rosparam python3-nav-msgs python3-sensor-msgs
   python3-map-msgs python3-std-srvs python3-diagnostic-msgs python3-geometry-msgs python3-std-msgs
+  python3-visualization-msgs
 )
 # `install_deps.sh fuzz` (make fuzz): clang and its libFuzzer / sanitizer runtimes as well.
 if [ "${1:-}" = fuzz ]; then

@@ -140,6 +140,11 @@ const std::vector<KeyReader>& readers() {
        [](auto& k, auto& v, Config* c) { c->map.lazy_forgetting = asBool(k, v); }},
       {"num_threads", [](auto& k, auto& v, Config* c) { c->map.num_threads = asInt(k, v); }},
       {"reflection", [](auto& k, auto& v, Config* c) { c->map.reflection = asBool(k, v); }},
+      {"ndt", [](auto& k, auto& v, Config* c) { c->map.ndt = asBool(k, v); }},
+      {"ndt_min_weight",
+       [](auto& k, auto& v, Config* c) { c->map.ndt_min_weight = asDouble(k, v); }},
+      {"ndt_max_weight",
+       [](auto& k, auto& v, Config* c) { c->map.ndt_max_weight = asDouble(k, v); }},
       // ---- ROS
       {"map_frame", [](auto& k, auto& v, Config* c) { c->ros.map_frame = asString(k, v); }},
       {"base_frame", [](auto& k, auto& v, Config* c) { c->ros.base_frame = asString(k, v); }},

@@ -1,12 +1,14 @@
 // Message <-> core conversions (see conversions.h).
 #include "wavog_mapping/ros/conversions.h"
 
+#include <sensor_msgs/point_cloud2_iterator.h>
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
 
 #include <algorithm>
 #include <boost/make_shared.hpp>
 #include <cmath>
+#include <vector>
 
 namespace wavog_ros {
 namespace {
@@ -195,6 +197,94 @@ nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
 nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::ReflectionRaster& raster,
                                                 const std::string& frame, const ros::Time& stamp) {
   return gridMsg(raster, frame, stamp);
+}
+
+namespace {
+double occupancyProbability(float log_odds) {
+  return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
+}
+}  // namespace
+
+void ndtEllipse(double cov_xx, double cov_xy, double cov_yy, double* major, double* minor,
+                double* yaw) {
+  // Eigenvalues of a symmetric 2x2: mean +- radius; the major axis at half the angle of
+  // (xx - yy, 2 xy). Rounding may leave a tiny negative eigenvalue: taken as 0.
+  const double mean = 0.5 * (cov_xx + cov_yy);
+  const double radius = std::hypot(0.5 * (cov_xx - cov_yy), cov_xy);
+  *major = 4.0 * std::sqrt(std::max(0.0, mean + radius));
+  *minor = 4.0 * std::sqrt(std::max(0.0, mean - radius));
+  *yaw = 0.5 * std::atan2(2.0 * cov_xy, cov_xx - cov_yy);
+}
+
+visualization_msgs::MarkerArray::Ptr toNdtMarkers(const wavog::NdtLayer& layer,
+                                                  const std::string& frame,
+                                                  const ros::Time& stamp) {
+  auto msg = boost::make_shared<visualization_msgs::MarkerArray>();
+  msg->markers.resize(layer.cells.size() + 1);
+  const std::string ns = "ndt_scale_" + std::to_string(layer.scale);
+  visualization_msgs::Marker& clear = msg->markers[0];
+  clear.header.frame_id = frame;
+  clear.header.stamp = stamp;
+  clear.ns = ns;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  const double min_axis = kNdtMinAxisCells * layer.cell_size;
+  for (std::size_t i = 0; i < layer.cells.size(); ++i) {
+    const wavog::NdtCell& c = layer.cells[i];
+    visualization_msgs::Marker& m = msg->markers[i + 1];
+    m.header = clear.header;
+    m.ns = ns;
+    m.id = static_cast<std::int32_t>(i + 1);
+    m.type = visualization_msgs::Marker::CYLINDER;
+    m.action = visualization_msgs::Marker::ADD;
+    double major = 0.0, minor = 0.0, yaw = 0.0;
+    ndtEllipse(c.cov_xx, c.cov_xy, c.cov_yy, &major, &minor, &yaw);
+    m.pose.position.x = c.mean_x;
+    m.pose.position.y = c.mean_y;
+    m.pose.position.z = kNdtMarkerThickness;  // just above the grids (z = 0)
+    m.pose.orientation.z = std::sin(0.5 * yaw);
+    m.pose.orientation.w = std::cos(0.5 * yaw);
+    m.scale.x = std::max(major, min_axis);
+    m.scale.y = std::max(minor, min_axis);
+    m.scale.z = kNdtMarkerThickness;
+    const double p = occupancyProbability(c.log_odds);
+    m.color.r = static_cast<float>(p);
+    m.color.g = 0.0f;
+    m.color.b = static_cast<float>(1.0 - p);
+    m.color.a = 0.8f;
+  }
+  return msg;
+}
+
+sensor_msgs::PointCloud2::Ptr toNdtCloud(const wavog::NdtLayer& layer, const std::string& frame,
+                                         const ros::Time& stamp) {
+  auto msg = boost::make_shared<sensor_msgs::PointCloud2>();
+  msg->header.frame_id = frame;
+  msg->header.stamp = stamp;
+  msg->height = 1;  // unorganised: resize() then sets the width
+  sensor_msgs::PointCloud2Modifier modifier(*msg);
+  using sensor_msgs::PointField;
+  // z (0: the map plane) is not NDT data: rviz draws, and PCL reads, only clouds with x, y and z.
+  modifier.setPointCloud2Fields(8, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32, "z", 1,
+                                PointField::FLOAT32, "cov_xx", 1, PointField::FLOAT32, "cov_xy", 1,
+                                PointField::FLOAT32, "cov_yy", 1, PointField::FLOAT32, "weight", 1,
+                                PointField::FLOAT32, "occupancy", 1, PointField::FLOAT32);
+  modifier.resize(layer.cells.size());
+  msg->is_dense = true;
+  // One iterator per field, in the order above.
+  constexpr std::size_t kFields = 8;
+  const char* const kNames[kFields] = {"x",      "y",      "z",      "cov_xx",
+                                       "cov_xy", "cov_yy", "weight", "occupancy"};
+  std::vector<sensor_msgs::PointCloud2Iterator<float>> it;
+  for (const char* f : kNames) it.emplace_back(*msg, f);
+  for (const wavog::NdtCell& c : layer.cells) {
+    const double values[kFields] = {c.mean_x, c.mean_y, 0.0,      c.cov_xx,
+                                    c.cov_xy, c.cov_yy, c.weight, occupancyProbability(c.log_odds)};
+    for (std::size_t f = 0; f < kFields; ++f) {
+      *it[f] = static_cast<float>(values[f]);
+      ++it[f];
+    }
+  }
+  return msg;
 }
 
 map_msgs::OccupancyGridUpdate::Ptr toOccupancyGridUpdateMsg(const wavog::Raster& raster,

@@ -3,9 +3,12 @@
 
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "wavog_mapping/io/map_files.h"
 #include "wavog_mapping/ros/conversions.h"
@@ -42,35 +45,50 @@ void DirtyRegion::add(const MapBox& b) {
 }
 
 MapPublisher::MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales,
-                           bool reflection)
-    : nh_(nh), reflection_(reflection) {
+                           bool reflection, bool ndt)
+    : nh_(nh), reflection_(reflection), ndt_(ndt) {
   map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
   update_pub_ = nh_.advertise<map_msgs::OccupancyGridUpdate>("map_updates", 10);
   if (reflection_) reflection_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("reflection", 1, true);
+  if (ndt_) {
+    ndt_markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("ndt_markers", 1, true);
+    ndt_cells_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("ndt_cells", 1, true);
+  }
   advertiseScales(scales);
 }
 
 namespace {
-// Publishers of `prefix`<s> for exactly `scales`, keeping those of `old` that stay.
+// Publishers of `prefix`<s> (messages M) for exactly `scales`, keeping those of `old` that stay.
+template <typename M>
 std::map<int, ros::Publisher> scalePublishers(ros::NodeHandle& nh, const std::string& prefix,
                                               const std::vector<int>& scales,
                                               const std::map<int, ros::Publisher>& old) {
   std::map<int, ros::Publisher> pubs;
   for (int s : scales) {
     auto it = old.find(s);
-    pubs[s] = it != old.end()
-                  ? it->second
-                  : nh.advertise<nav_msgs::OccupancyGrid>(prefix + std::to_string(s), 1);
+    pubs[s] = it != old.end() ? it->second : nh.advertise<M>(prefix + std::to_string(s), 1);
   }
   return pubs;
+}
+
+// The publisher of scale s in `pubs` if it has subscribers, else a null one.
+ros::Publisher ifSubscribed(const std::map<int, ros::Publisher>& pubs, int s) {
+  const auto it = pubs.find(s);
+  return it != pubs.end() && it->second.getNumSubscribers() > 0 ? it->second : ros::Publisher();
 }
 }  // namespace
 
 void MapPublisher::advertiseScales(const std::vector<int>& scales) {
-  scale_pubs_ = scalePublishers(nh_, "map_scale_", scales, scale_pubs_);
+  scale_pubs_ = scalePublishers<nav_msgs::OccupancyGrid>(nh_, "map_scale_", scales, scale_pubs_);
   if (reflection_) {
-    reflection_scale_pubs_ =
-        scalePublishers(nh_, "reflection_scale_", scales, reflection_scale_pubs_);
+    reflection_scale_pubs_ = scalePublishers<nav_msgs::OccupancyGrid>(
+        nh_, "reflection_scale_", scales, reflection_scale_pubs_);
+  }
+  if (ndt_) {
+    ndt_markers_scale_pubs_ = scalePublishers<visualization_msgs::MarkerArray>(
+        nh_, "ndt_markers_scale_", scales, ndt_markers_scale_pubs_);
+    ndt_cells_scale_pubs_ = scalePublishers<sensor_msgs::PointCloud2>(
+        nh_, "ndt_cells_scale_", scales, ndt_cells_scale_pubs_);
   }
 }
 
@@ -90,18 +108,25 @@ void MapPublisher::markAllDirty(double resolution) {
 Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params, double cx,
                           double cy) {
   Layers out;
-  // `map` and `reflection` are latched: always published. A scale layer nobody listens to costs
-  // nothing; a reflection scale layer reads its occupancy layer for the box, publishing it only
-  // when that has listeners too.
-  out.layers.push_back({0, map_pub_, reflection_pub_, {}, {}});
+  // `map`, `reflection`, `ndt_markers` and `ndt_cells` are latched: always published. A scale
+  // layer nobody listens to costs nothing; a payload's scale layer reads its occupancy layer for
+  // the box, publishing that only when it has listeners too.
+  Layers::Layer finest;
+  finest.pub = map_pub_;
+  finest.reflection_pub = reflection_pub_;
+  finest.ndt_markers_pub = ndt_markers_pub_;
+  finest.ndt_cells_pub = ndt_cells_pub_;
+  out.layers.push_back(std::move(finest));
   for (const auto& sp : scale_pubs_) {
-    const auto rp = reflection_scale_pubs_.find(sp.first);
-    const ros::Publisher reflection =
-        rp != reflection_scale_pubs_.end() && rp->second.getNumSubscribers() > 0 ? rp->second
-                                                                                 : ros::Publisher();
-    const ros::Publisher occupancy =
-        sp.second.getNumSubscribers() > 0 ? sp.second : ros::Publisher();
-    if (occupancy || reflection) out.layers.push_back({sp.first, occupancy, reflection, {}, {}});
+    Layers::Layer layer;
+    layer.scale = sp.first;
+    layer.pub = ifSubscribed(scale_pubs_, sp.first);
+    layer.reflection_pub = ifSubscribed(reflection_scale_pubs_, sp.first);
+    layer.ndt_markers_pub = ifSubscribed(ndt_markers_scale_pubs_, sp.first);
+    layer.ndt_cells_pub = ifSubscribed(ndt_cells_scale_pubs_, sp.first);
+    if (layer.pub || layer.reflection_pub || layer.ndt_markers_pub || layer.ndt_cells_pub) {
+      out.layers.push_back(std::move(layer));
+    }
   }
   for (Layers::Layer& layer : out.layers) {
     // With a window, the read-out costs what the window holds, never the whole map.
@@ -126,6 +151,11 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
       layer.reflection = map.exportReflection(layer.scale, layer.raster.box);
       layer.reflection.cell_size = layer.raster.cell_size;  // also for an empty box
     }
+    if (layer.ndt_markers_pub || layer.ndt_cells_pub) {
+      if (!layer.raster.box.empty()) layer.ndt = map.exportNdt(layer.scale, layer.raster.box);
+      layer.ndt.scale = layer.scale;
+      layer.ndt.cell_size = layer.raster.cell_size;  // also for an empty box
+    }
     if (layer.scale == 0) {
       // The dirty region is reset by map_updates only: re-sending an area the full map already
       // carries is harmless, while two timers of the same period would otherwise starve updates.
@@ -142,6 +172,8 @@ void MapPublisher::publish(const Layers& layers, const std::string& frame, const
     if (layer.reflection_pub) {
       layer.reflection_pub.publish(toOccupancyGridMsg(layer.reflection, frame, stamp));
     }
+    if (layer.ndt_markers_pub) layer.ndt_markers_pub.publish(toNdtMarkers(layer.ndt, frame, stamp));
+    if (layer.ndt_cells_pub) layer.ndt_cells_pub.publish(toNdtCloud(layer.ndt, frame, stamp));
   }
 }
 

@@ -1,8 +1,10 @@
 // Publication of the map: the `map` layer (latched) and the map_scale_<s> layers, cut to a window
-// around the robot or the whole map, and with MapParams::reflection the `reflection` (latched) and
-// reflection_scale_<s> layers over the same boxes; map_updates, the changed rectangle of the finest
-// layer, from one dirty region. Reads happen under the caller's lock (MappingRos::Impl::mutex_,
-// which guards this object and the map); publish() and publishUpdate() run without it.
+// around the robot or the whole map, and over the same boxes with MapParams::reflection the
+// `reflection` (latched) and reflection_scale_<s> layers, with MapParams::ndt the NDT cells as
+// ndt_markers / ndt_cells (latched) and ndt_markers_scale_<s> / ndt_cells_scale_<s>;
+// map_updates, the changed rectangle of the finest layer, from one dirty region. Reads happen under
+// the caller's lock (MappingRos::Impl::mutex_, which guards this object and the map); publish() and
+// publishUpdate() run without it.
 #ifndef WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
 #define WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
 
@@ -33,11 +35,14 @@ struct DirtyRegion {
 /// The layers of one full publication, read from the map.
 struct Layers {
   struct Layer {
-    int scale;
-    ros::Publisher pub;             ///< occupancy; null when only its reflection is wanted
-    ros::Publisher reflection_pub;  ///< null when its reflection is not wanted
+    int scale = 0;
+    ros::Publisher pub;              ///< occupancy; null when only its payloads are wanted
+    ros::Publisher reflection_pub;   ///< null when its reflection is not wanted
+    ros::Publisher ndt_markers_pub;  ///< null when its NDT markers are not wanted
+    ros::Publisher ndt_cells_pub;    ///< null when its NDT cloud is not wanted
     wavog::Raster raster;
     wavog::ReflectionRaster reflection;  ///< over raster's box
+    wavog::NdtLayer ndt;                 ///< over raster's box, when an NDT publisher is set
   };
   std::vector<Layer> layers;
   std::vector<std::string> refused;  ///< one line per layer larger than kMaxLayerCells
@@ -46,8 +51,10 @@ struct Layers {
 class MapPublisher {
  public:
   /// Advertises map, map_updates and map_scale_<s> for `scales` on `nh`; with `reflection`, also
-  /// reflection and reflection_scale_<s>.
-  MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales, bool reflection);
+  /// reflection and reflection_scale_<s>; with `ndt`, also ndt_markers, ndt_cells,
+  /// ndt_markers_scale_<s> and ndt_cells_scale_<s>.
+  MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales, bool reflection,
+               bool ndt);
 
   /// Publishes map_scale_<s> for exactly `scales` (publishers of kept scales are kept).
   void advertiseScales(const std::vector<int>& scales);
@@ -81,6 +88,9 @@ class MapPublisher {
   bool reflection_ = false;
   ros::Publisher reflection_pub_;
   std::map<int, ros::Publisher> reflection_scale_pubs_;
+  bool ndt_ = false;
+  ros::Publisher ndt_markers_pub_, ndt_cells_pub_;
+  std::map<int, ros::Publisher> ndt_markers_scale_pubs_, ndt_cells_scale_pubs_;
   DirtyRegion dirty_;
   bool have_full_ = false;
   wavog::CellBox last_full_box_;  ///< scale-0 box of the last full `map`

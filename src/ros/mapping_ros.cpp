@@ -44,8 +44,8 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   }
   subscribeTf();
 
-  publisher_ =
-      std::make_unique<MapPublisher>(nh_, rp.publish_scales, config_.map.reflection);  // not yet shared: no lock
+  publisher_ = std::make_unique<MapPublisher>(nh_, rp.publish_scales, config_.map.reflection,
+                                              config_.map.ndt);  // not yet shared: no lock
   status_pub_ = pnh_.advertise<wavog_mapping::MapperStatus>("status", 10);
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
   updater_->setHardwareID("wavog_mapping");

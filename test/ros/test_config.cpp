@@ -48,6 +48,10 @@ void expectSame(const Config& a, const Config& b) {
   EXPECT_EQ(a.map.skip_tolerance, b.map.skip_tolerance);
   EXPECT_EQ(a.map.lazy_forgetting, b.map.lazy_forgetting);
   EXPECT_EQ(a.map.num_threads, b.map.num_threads);
+  EXPECT_EQ(a.map.reflection, b.map.reflection);
+  EXPECT_EQ(a.map.ndt, b.map.ndt);
+  EXPECT_EQ(a.map.ndt_min_weight, b.map.ndt_min_weight);
+  EXPECT_EQ(a.map.ndt_max_weight, b.map.ndt_max_weight);
   EXPECT_EQ(a.ros.map_frame, b.ros.map_frame);
   EXPECT_EQ(a.ros.base_frame, b.ros.base_frame);
   ASSERT_EQ(a.ros.inputs.size(), b.ros.inputs.size());
@@ -132,6 +136,20 @@ resolution: 1
   EXPECT_EQ(c.ros.publish_scales, (std::vector<int>{1, 5}));
   EXPECT_EQ(c.ros.scale_aggregation, wavog::Aggregation::kMax);
   EXPECT_EQ(c.map.grid.resolution, 1.0);  // an int is accepted for a double
+}
+
+TEST(Config, ReadsTheNdtKeys) {
+  const Config off = fromYaml("{}");
+  EXPECT_FALSE(off.map.ndt);  // off by default
+  const Config c = fromYaml("{ndt: true, ndt_min_weight: 0.5, ndt_max_weight: 20}");
+  EXPECT_TRUE(c.map.ndt);
+  EXPECT_EQ(c.map.ndt_min_weight, 0.5);
+  EXPECT_EQ(c.map.ndt_max_weight, 20.0);
+  EXPECT_NE(errorOf("ndt: 1").find("'ndt'"), std::string::npos);
+  EXPECT_NE(errorOf("ndt_min_weight: -1").find("ndt_min_weight (-1) must be in [0, 1e6]"),
+            std::string::npos);
+  EXPECT_NE(errorOf("ndt_max_weight: 0.5").find("ndt_max_weight (0.5) must be in [1, 1e9]"),
+            std::string::npos);
 }
 
 TEST(Config, ReportsUnknownKeys) {

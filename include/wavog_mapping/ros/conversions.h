@@ -1,5 +1,6 @@
 // Conversions between ROS messages and the core: LaserScan checks and views, tf -> planar pose,
-// Raster -> OccupancyGrid. Stateless free functions: thread-safe.
+// Raster -> OccupancyGrid, NdtLayer -> MarkerArray / PointCloud2. Stateless free functions:
+// thread-safe.
 #ifndef WAVOG_MAPPING_ROS_CONVERSIONS_H_
 #define WAVOG_MAPPING_ROS_CONVERSIONS_H_
 
@@ -7,6 +8,8 @@
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <cstddef>
 #include <string>
@@ -102,6 +105,30 @@ nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
 /// Reflection probabilities as an OccupancyGrid (0..100 from p, -1 where never observed).
 nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::ReflectionRaster& raster,
                                                 const std::string& frame, const ros::Time& stamp);
+
+/// Thickness (m) of an NDT ellipse marker, and the smallest axis of one, as a fraction of the
+/// layer's cell size (a cell of one end-point has covariance 0 and would not be drawn).
+constexpr double kNdtMarkerThickness = 0.01;
+constexpr double kNdtMinAxisCells = 0.1;
+
+/// The axes of the 2-sigma ellipse of a 2D covariance [[xx, xy], [xy, yy]]: *major, *minor are
+/// the full lengths (4 sqrt(eigenvalue), m), *yaw the angle (rad) of the major axis from x.
+void ndtEllipse(double cov_xx, double cov_xy, double cov_yy, double* major, double* minor,
+                double* yaw);
+
+/// The NDT cells of one layer for rviz: a DELETEALL first (the layer replaces the last one as a
+/// whole), then per Gaussian a flat CYLINDER in `frame`, namespace "ndt_scale_<s>", id 1, 2, ...
+/// in the layer's order: at the mean, yawed along the major axis, its 2-sigma ellipse
+/// (ndtEllipse; each axis at least kNdtMinAxisCells x cell size), coloured from blue (P(occ) 0)
+/// to red (P(occ) 1) by the cell's occupancy.
+visualization_msgs::MarkerArray::Ptr toNdtMarkers(const wavog::NdtLayer& layer,
+                                                  const std::string& frame, const ros::Time& stamp);
+
+/// The NDT cells of one layer as an unorganised cloud (height 1, one point per Gaussian, the
+/// layer's order) with float32 fields x, y (the mean, m), z (0, so that rviz and PCL take it),
+/// cov_xx, cov_xy, cov_yy (m^2), weight and occupancy (P(occ) of the cell, 0..1), in `frame`.
+sensor_msgs::PointCloud2::Ptr toNdtCloud(const wavog::NdtLayer& layer, const std::string& frame,
+                                         const ros::Time& stamp);
 
 /// The raster as an update of a grid whose cell (0, 0) is the scale-s cell (grid_min_x,
 /// grid_min_y): x, y are the raster's offsets in that grid.
