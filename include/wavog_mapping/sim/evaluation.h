@@ -1,8 +1,9 @@
 // Policy evaluation against the simulator's ground truth: runs a scenario's scans through the
 // core map (wavog::WaveletMap) under each update policy and measures responsiveness (how long a
 // departed car's cells stay occupied, how long an arrived car takes to appear), precision (occupied
-// cells against the true surfaces, thickness of walls), compactness (nodes, bytes per observed
-// cell) and integration time. ROS-free. Not thread-safe (one evaluation per thread).
+// cells against the true surfaces, thickness of walls, and with MapParams::ndt the NDT means
+// against the true walls), compactness (nodes, bytes per observed cell) and integration time.
+// ROS-free. Not thread-safe (one evaluation per thread).
 #ifndef WAVOG_MAPPING_SIM_EVALUATION_H_
 #define WAVOG_MAPPING_SIM_EVALUATION_H_
 
