@@ -6,9 +6,11 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
+#include "ndt_store.h"
 #include "node_pool.h"
 
 namespace wavog {
@@ -23,6 +25,8 @@ struct Block {
   bool known_any = false;  ///< some cell observed
   /// Node groups this block freed during integrations, reused by its next ones (NodeStore).
   std::vector<std::uint32_t> spare;
+  /// MapParams::ndt: the Gaussians of its cells (made with the first end-point in the block).
+  std::unique_ptr<NdtCells> ndt;
 };
 
 inline std::uint64_t blockKey(std::int64_t bx, std::int64_t by) {

@@ -1,5 +1,6 @@
 // Region clearing of WaveletMap: clearBox() sets every finest cell of a rectangle back to the
-// prior and unobserved, block by block and coarse to fine, pruning what becomes trivial.
+// prior and unobserved, block by block and coarse to fine, pruning what becomes trivial; its
+// normal-distribution cells (MapParams::ndt) go too.
 #include <array>
 #include <cmath>
 #include <vector>
@@ -83,6 +84,14 @@ std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, doubl
       if (b.has_root) impl.removeRoot(&b);
       impl.eraseBlock(key);
       continue;
+    }
+    if (b.ndt) {
+      b.ndt->removeIf([&](const detail::NdtEntry& e) {
+        std::uint32_t lx, ly;
+        detail::mortonCell(e.code, &lx, &ly);
+        const std::int64_t ix = x0 + lx, iy = y0 + ly;
+        return ix >= box.x0 && ix <= box.x1 && iy >= box.y0 && iy <= box.y1;
+      });
     }
     // The block's groups stay with it (as in an integration, see NodeStore).
     detail::NodeStore store(impl.pool, &b.spare, &impl.nodes, impl.pool.liveCounter());

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "map_impl.h"
+#include "ndt_update.h"
 #include "quadtree_update.h"
 #include "scan_classifier.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -35,12 +36,27 @@ CellBox reachBox(double px, double py, double reach, double res) {
   return box;
 }
 
-// One block of the scan: its storage, origin cell and class.
+// One block of the scan: its storage, origin cell and class, and its end-points (MapParams::ndt).
 struct BlockJob {
   detail::Block* block;
   std::int64_t ix0, iy0;
   detail::SquareInfo box;
+  const detail::NdtPoint *points = nullptr, *points_end = nullptr;
 };
+
+// The NDT policy of one scan (params.h, MapParams::ndt): forgetting by the scan's rate, the
+// clamp policies' weight cap, sums otherwise.
+detail::NdtConsts ndtConsts(const MapParams& p, double a, double g) {
+  detail::NdtConsts c;
+  c.min_weight = p.ndt_min_weight;
+  if (p.policy.type == PolicyType::kForget) {
+    c.a = a;
+    c.g = g;
+  } else if (p.policy.type == PolicyType::kClamp || p.policy.type == PolicyType::kClampUpper) {
+    c.cap = p.ndt_max_weight;
+  }
+  return c;
+}
 
 // Node groups one block can take in one scan at most: a group per node of levels 2..L (a
 // block's live and spare groups never exceed that, and fresh ones are taken only when its
@@ -72,12 +88,13 @@ void orderByWork(const detail::PreparedScan& ps, double block_size, std::vector<
 }
 
 // Updates the blocks jobs[i] for the indices i taken from `next` (shared by the threads of one
-// scan); node groups from `store`. Returns the nodes visited. The one place Integrator<P> is
-// made, so the hot code is compiled once per policy.
+// scan); node groups from `store`; with `ndt`, their Gaussians too. Returns the nodes visited.
+// The one place Integrator<P> is made, so the hot code is compiled once per policy.
 template <PolicyType P>
 [[gnu::noinline]] std::uint64_t updateBlocks(WaveletMap::Impl& impl, detail::NodeStore& store,
                                              const ScanClassifier& cls,
                                              const detail::PolicyConsts& pc,
+                                             const detail::NdtConsts* ndt,
                                              const std::vector<BlockJob>& jobs,
                                              std::atomic<std::size_t>* next) {
   detail::Integrator<P> integrator(impl, store, cls, pc);
@@ -86,6 +103,10 @@ template <PolicyType P>
     const BlockJob& j = jobs[i];
     store.useSpare(&j.block->spare);
     integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
+    if (ndt != nullptr && j.block->ndt) {
+      detail::NdtBlockUpdate(cls, *ndt, impl.levels)
+          .update(*j.block->ndt, j.ix0, j.iy0, j.box, j.points, j.points_end);
+    }
   }
   return integrator.visited();
 }
@@ -126,6 +147,22 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
       jobs.push_back({&impl.getOrCreateBlock(bx, by), ix0, iy0, box});
     }
   }
+  // NDT: the scan's end-points by block; a block takes its Gaussians with its first end-point.
+  thread_local detail::NdtScanPoints ndt_points;
+  detail::NdtConsts ndt_consts;
+  const detail::NdtConsts* ndt = nullptr;
+  if (p.ndt) {
+    ndt_consts = ndtConsts(p, a, g);
+    ndt = &ndt_consts;
+    ndt_points.build(ps, L);
+    for (BlockJob& j : jobs) {
+      ndt_points.inBlock(detail::blockKey(detail::floorShift(j.ix0, L), detail::floorShift(j.iy0, L)),
+                         &j.points, &j.points_end);
+      if (j.points != j.points_end && !j.block->ndt) {
+        j.block->ndt = std::make_unique<detail::NdtCells>();
+      }
+    }
+  }
   st->blocks_touched = static_cast<std::uint32_t>(jobs.size());
   // The blocks are independent: each one's update reads only the scan and the parameters and
   // changes only its own nodes, taking node groups from its own spares (NodeStore), so the result
@@ -136,7 +173,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
   std::atomic<std::size_t> next{0};
   if (threads <= 1) {
     detail::NodeStore store(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
-    return visited + updateBlocks<P>(impl, store, cls, pc, jobs, &next);
+    return visited + updateBlocks<P>(impl, store, cls, pc, ndt, jobs, &next);
   }
   orderByWork(ps, block_size, &jobs);
   if (!*workers || (*workers)->threads() != threadsFor(p)) {
@@ -155,7 +192,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     if (tu >= active) return;
     Tally& tally = tallies[tu];
     detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
-    tally.visited = updateBlocks<P>(impl, store, cls, pc, jobs, &next);
+    tally.visited = updateBlocks<P>(impl, store, cls, pc, ndt, jobs, &next);
   });
   for (const Tally& tally : tallies) {
     visited += tally.visited;

@@ -1,4 +1,4 @@
-// Native map files. Layout (little-endian, version 2):
+// Native map files. Layout (little-endian, version 3):
 //   "WAVOGMAP" | u32 version | f64 resolution | i32 block_levels | f64 prior | f64 a (the factor
 //   one pending unit stands for: 1 - gamma, or 2^-unit with forget_half_life) | u64 block count
 //   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
@@ -6,9 +6,12 @@
 //               u8 child_mask | u8 known_all | u8 known_any | children in q order]
 //   u8 reflection layers n (0, 1: hits, 2: hits and misses), each: f64 a | u64 block count |
 //   blocks as above
+//   u64 count of blocks with normal-distribution cells (MapParams::ndt), each: i32 bx | i32 by |
+//   u32 n | n cells ascending by Morton code within the block: u32 code | f64 w sx sy sxx sxy syy
+//   (moments about the cell's centre, ndt_store.h)
 //   u32 CRC-32 (IEEE) of every byte before it.
-// Version 1 (before forget_half_life and reflection) is the same with a u8 pending count and no
-// layers; it still loads.
+// Version 2 (before ndt) is the same without the last section, version 1 (before forget_half_life
+// and reflection) also with a u8 pending count and no layers; both still load.
 // Stored details and lazy counts are written as they are, so a round trip is bit-exact; a map
 // loaded under another factor applies the file's pending tags while loading.
 // Files are written and read through map_file.h (exclusive temporary + rename, regular files only).
@@ -18,6 +21,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -33,12 +37,15 @@ using detail::Block;
 using detail::Node;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
-constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kVersion = 3;
 constexpr std::uint32_t kOldestVersion = 1;  // u8 pending counts
 // Fixed header: magic, version, resolution, block_levels, prior, forgetting factor, block count.
 constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
 constexpr std::size_t kCrcBytes = 4;
 constexpr std::size_t kMinBlockBytes = 4 + 4 + 8 + 1;  // bx, by, average, flags
+constexpr std::size_t kNdtBlockBytes = 4 + 4 + 4;         // bx, by, cell count
+constexpr std::size_t kNdtCellBytes = 4 + 6 * 8;          // code, moments
+constexpr double kMaxNdtWeight = 1e15;  // end-points of one cell a file may claim
 // Three details, k, mask, known bits.
 std::size_t nodeBytes(std::uint32_t version) { return 3 * 4 + (version == 1 ? 1 : 2) + 3; }
 
@@ -178,9 +185,16 @@ std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
                          maps * static_cast<double>(count) *
                              (static_cast<double>(kMinBlockBytes) +
                               nodes_per_block * static_cast<double>(nodeBytes(version)));
-  if (static_cast<double>(size) > largest) {
+  // Version 3 adds the Gaussians: at most every cell of every block.
+  const double ndt = version >= 3 ? 8.0 + static_cast<double>(count) *
+                                              (static_cast<double>(kNdtBlockBytes) +
+                                               std::ldexp(1.0, 2 * levels) *
+                                                   static_cast<double>(kNdtCellBytes))
+                                  : 0.0;
+  if (static_cast<double>(size) > largest + ndt) {
     throw fail(std::to_string(size) + " bytes, more than its " + std::to_string(count) +
-               " blocks can fill (at most " + std::to_string(static_cast<std::uint64_t>(largest)) +
+               " blocks can fill (at most " +
+               std::to_string(static_cast<std::uint64_t>(largest + ndt)) +
                " bytes at block_levels " + std::to_string(levels) + ")");
   }
   if (size > std::numeric_limits<std::size_t>::max()) throw fail("too large to read");
@@ -237,6 +251,68 @@ void readBlocks(WaveletMap::Impl& fresh, const PendingFormat& format, std::size_
   }
 }
 
+// The normal-distribution cells of the blocks that hold some, each block's in code order.
+void writeNdt(const WaveletMap::Impl& impl, Writer* w) {
+  std::uint64_t count = 0;
+  for (const auto& kv : impl.blocks) count += kv.second.ndt && !kv.second.ndt->empty() ? 1 : 0;
+  w->put(count);
+  std::vector<detail::NdtEntry> cells;
+  for (const auto& kv : impl.blocks) {
+    if (!kv.second.ndt || kv.second.ndt->empty()) continue;
+    cells = kv.second.ndt->entries;
+    std::sort(cells.begin(), cells.end(),
+              [](const detail::NdtEntry& a, const detail::NdtEntry& b) { return a.code < b.code; });
+    w->put(static_cast<std::int32_t>(detail::blockKeyX(kv.first)));
+    w->put(static_cast<std::int32_t>(detail::blockKeyY(kv.first)));
+    w->put(static_cast<std::uint32_t>(cells.size()));
+    for (const detail::NdtEntry& e : cells) {
+      w->put(e.code);
+      for (double v : {e.m.w, e.m.sx, e.m.sy, e.m.sxx, e.m.sxy, e.m.syy}) w->put(v);
+    }
+  }
+}
+
+// Reads the Gaussians into `fresh`'s blocks (read before); `keep`: false drops them (a map
+// without ndt).
+void readNdt(WaveletMap::Impl& fresh, bool keep, std::size_t bytes, Reader* r) {
+  const auto count = r->get<std::uint64_t>();
+  if (count > bytes / kNdtBlockBytes) throw std::runtime_error("bad NDT block count");
+  const std::uint64_t cells_per_block = std::uint64_t{1} << (2 * fresh.levels);
+  for (std::uint64_t i = 0; i < count; ++i) {
+    const auto bx = r->get<std::int32_t>();
+    const auto by = r->get<std::int32_t>();
+    const auto n = r->get<std::uint32_t>();
+    Block* b = fresh.findBlock(bx, by);
+    if (b == nullptr) throw std::runtime_error("NDT cells in a block the file does not hold");
+    if (n == 0 || n > cells_per_block || n > bytes / kNdtCellBytes) {
+      throw std::runtime_error("bad NDT cell count");
+    }
+    if (b->ndt) throw std::runtime_error("duplicate NDT block");
+    auto cells = std::make_unique<detail::NdtCells>();
+    cells->entries.resize(n);
+    for (std::uint32_t j = 0; j < n; ++j) {
+      detail::NdtEntry& e = cells->entries[j];
+      e.code = r->get<std::uint32_t>();
+      for (double* v : {&e.m.w, &e.m.sx, &e.m.sy, &e.m.sxx, &e.m.sxy, &e.m.syy}) {
+        *v = r->get<double>();
+        if (!std::isfinite(*v)) throw std::runtime_error("non-finite NDT moment");
+      }
+      if (e.code >= cells_per_block || (j > 0 && e.code <= cells->entries[j - 1].code)) {
+        throw std::runtime_error("NDT cells out of order");
+      }
+      // End-points lie in their cell: |offset| <= res / 2 (with round-off), weights are finite.
+      const double h = 0.5 * fresh.params.grid.resolution * (1.0 + 1e-9), w = e.m.w;
+      if (!(w > 0.0 && w <= kMaxNdtWeight) || std::fabs(e.m.sx) > w * h ||
+          std::fabs(e.m.sy) > w * h || !(e.m.sxx >= 0.0 && e.m.sxx <= w * h * h) ||
+          !(e.m.syy >= 0.0 && e.m.syy <= w * h * h) || std::fabs(e.m.sxy) > w * h * h) {
+        throw std::runtime_error("NDT cell with moments no end-points in the cell can have");
+      }
+    }
+    cells->sorted = n;
+    if (keep) b->ndt = std::move(cells);
+  }
+}
+
 double readUnitFactor(Reader* r) {
   const auto a = r->get<double>();
   if (!(a >= 0.0 && a <= 1.0)) throw std::runtime_error("bad forgetting factor");
@@ -265,6 +341,7 @@ void WaveletMap::save(const std::string& path) const {
     w.put(l.unitFactor());
     writeBlocks(l, &w);
   }
+  writeNdt(impl, &w);
   auto& buf = w.buffer();
   const std::uint32_t crc = crc32(buf.data(), buf.size());
   w.put(crc);
@@ -315,6 +392,7 @@ void WaveletMap::load(const std::string& path) {
                    &r);
       }
     }
+    if (version >= 3) readNdt(fresh, impl_->params.ndt, data.size(), &r);
     if (!r.done()) throw std::runtime_error("trailing bytes");
   } catch (const MapIoError&) {
     throw;

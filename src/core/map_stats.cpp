@@ -1,5 +1,5 @@
-// Figures of WaveletMap: stats() counts blocks, nodes, bytes used and reserved, the last scan's
-// visits and (on request) the observed cells.
+// Figures of WaveletMap: stats() counts blocks, nodes, bytes used and reserved (normal-distribution
+// cells included), the last scan's visits and (on request) the observed cells.
 #include "map_impl.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
@@ -33,8 +33,14 @@ MapStats WaveletMap::stats(bool count_observed) const {
   for (const auto& kv : impl.blocks) spare += kv.second.spare.capacity() * sizeof(std::uint32_t);
   const std::size_t rest = impl.blocks.size() * per_block +
                            impl.blocks.bucket_count() * sizeof(void*) + sizeof(Impl) + spare;
-  st.bytes = impl.pool.bytes() + rest;
-  st.bytes_reserved = impl.pool.bytesReserved() + rest;
+  for (const auto& kv : impl.blocks) {
+    const detail::NdtCells* ndt = kv.second.ndt.get();
+    if (ndt == nullptr) continue;
+    st.ndt_cells += ndt->entries.size();
+    st.ndt_bytes += sizeof(detail::NdtCells) + ndt->entries.capacity() * sizeof(detail::NdtEntry);
+  }
+  st.bytes = impl.pool.bytes() + rest + st.ndt_bytes;
+  st.bytes_reserved = impl.pool.bytesReserved() + rest + st.ndt_bytes;
   st.nodes_visited_last = impl.nodes_visited_last;
   for (const WaveletMap* layer : {impl.hits.get(), impl.misses.get()}) {
     if (layer == nullptr) continue;

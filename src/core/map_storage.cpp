@@ -142,7 +142,9 @@ void WaveletMap::Impl::dropIfEmpty(std::int64_t bx, std::int64_t by) {
   auto it = blocks.find(detail::blockKey(bx, by));
   if (it == blocks.end()) return;
   const Block& b = it->second;
-  if (!b.has_root && !b.known_any && b.s == init) eraseBlock(it->first);
+  if (!b.has_root && !b.known_any && b.s == init && !(b.ndt && !b.ndt->empty())) {
+    eraseBlock(it->first);
+  }
 }
 
 void WaveletMap::Impl::eraseBlock(std::uint64_t key) {

@@ -154,8 +154,8 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
       kind[j] = BeamKind::kHit;
       ze = z - half_band;
       zu = z + half_band;
-      const double bearing = theta + (amin + static_cast<double>(j) * inc);
-      const double ex = px + z * std::cos(bearing), ey = py + z * std::sin(bearing);
+      double ex, ey;
+      endpoint(j, &ex, &ey);
       hit_x[j] = static_cast<std::int64_t>(std::floor(ex / res));
       hit_y[j] = static_cast<std::int64_t>(std::floor(ey / res));
       hits.push_back(cellKey(hit_x[j], hit_y[j]));

@@ -83,6 +83,13 @@ struct PreparedScan {
     return invalid_prefix[static_cast<std::size_t>(hi) + 1] >
            invalid_prefix[static_cast<std::size_t>(lo)];
   }
+  /// The map-frame end-point of hit beam j, computed as for its cell (hit_x, hit_y).
+  void endpoint(std::size_t j, double* ex, double* ey) const {
+    const double z = ranges_[j];
+    const double bearing = theta + (amin + static_cast<double>(j) * inc);
+    *ex = px + z * std::cos(bearing);
+    *ey = py + z * std::sin(bearing);
+  }
   /// True if beam j is a hit whose endpoint lies in cell (ix, iy).
   bool hitsCell(std::size_t j, std::int64_t ix, std::int64_t iy) const {
     return kind[j] == BeamKind::kHit && hit_x[j] == ix && hit_y[j] == iy;

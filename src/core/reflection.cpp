@@ -16,6 +16,7 @@ namespace wavog {
 MapParams WaveletMap::Impl::layerParams(const MapParams& main, bool hits) {
   MapParams p = main;
   p.reflection = false;
+  p.ndt = false;
   p.policy.init = InitValue::kUnknown;  // no count yet
   // Forgetting forgets the counts by the map's gamma; every other policy counts (see params.h).
   p.policy.type = main.policy.type == PolicyType::kForget ? PolicyType::kForget : PolicyType::kNone;

@@ -127,6 +127,21 @@ bool ReferenceClassifier::prepare(const wavog::MapParams& p, const wavog::Pose2&
   return any_valid;
 }
 
+std::vector<std::pair<double, double>> ReferenceClassifier::endpoints(
+    const wavog::Pose2& pose, const wavog::ScanView& scan) const {
+  std::vector<std::pair<double, double>> out;
+  std::vector<double> ranges(scan.ranges, scan.ranges + n_);
+  if (scan.angle_increment < 0) std::reverse(ranges.begin(), ranges.end());
+  for (int j = 0; j < n_; ++j) {
+    const auto ju = static_cast<std::size_t>(j);
+    if (kind_[ju] != 1) continue;
+    const double z = ranges[ju];
+    const double bearing = pose.theta + (amin_ + static_cast<double>(j) * inc_);
+    out.emplace_back(pose.x + z * std::cos(bearing), pose.y + z * std::sin(bearing));
+  }
+  return out;
+}
+
 wavog::CellClass ReferenceClassifier::cellClass(std::int64_t ix, std::int64_t iy) const {
   if (hits_.count({ix, iy})) return wavog::CellClass::kOccupied;
   const double dx = (static_cast<double>(ix) + 0.5) * res_ - pose_.x;
@@ -169,6 +184,99 @@ void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& 
       ++last_updated_;
     }
   }
+  if (p_.ndt) integrateNdt(ref, pose, scan);
+}
+
+// Normal-distribution cells (MapParams::ndt) of layer 0: every observed cell's moments forget by
+// 1 - gamma ("forget"), then each end-point adds itself with weight gamma (1 for the other
+// policies), the clamp policies cap the weight, and cells under ndt_min_weight are dropped.
+void DenseReference::integrateNdt(const ReferenceClassifier& ref, const wavog::Pose2& pose,
+                                  const wavog::ScanView& scan) {
+  const wavog::MapParams& p = layers_.at(0);
+  const bool forget = p.policy.type == PolicyType::kForget;
+  const double g = forget ? p.policy.gamma : 1.0;
+  if (forget) {
+    for (auto& kv : ndt_) {
+      const wavog::CellClass cls = ref.cellClass(kv.first.second, kv.first.first);
+      if (cls == wavog::CellClass::kUnknown) continue;
+      Moments& m = kv.second;
+      for (double* v : {&m.w, &m.x, &m.y, &m.xx, &m.xy, &m.yy}) *v *= 1.0 - g;
+    }
+  }
+  // The end-points, in the core's beam order (ascending bearing).
+  std::vector<std::pair<double, double>> points = ref.endpoints(pose, scan);
+  std::set<std::pair<std::int64_t, std::int64_t>> touched;
+  const double res = p.grid.resolution;
+  for (const auto& e : points) {
+    const std::pair<std::int64_t, std::int64_t> key{static_cast<std::int64_t>(std::floor(e.second / res)),
+                                                    static_cast<std::int64_t>(std::floor(e.first / res))};
+    Moments& m = ndt_[key];
+    m.w += g;
+    m.x += g * e.first;
+    m.y += g * e.second;
+    m.xx += g * e.first * e.first;
+    m.xy += g * e.first * e.second;
+    m.yy += g * e.second * e.second;
+    touched.insert(key);
+  }
+  if (p.policy.type == PolicyType::kClamp || p.policy.type == PolicyType::kClampUpper) {
+    for (const auto& key : touched) {
+      Moments& m = ndt_[key];
+      if (m.w <= p.ndt_max_weight) continue;
+      const double f = p.ndt_max_weight / m.w;
+      for (double* v : {&m.w, &m.x, &m.y, &m.xx, &m.xy, &m.yy}) *v *= f;
+    }
+  }
+  for (auto it = ndt_.begin(); it != ndt_.end();) {
+    if (it->second.w >= p.ndt_min_weight && it->second.w > 0.0) {
+      ++it;
+    } else {
+      it = ndt_.erase(it);
+    }
+  }
+}
+
+wavog::NdtCell DenseReference::gaussian(const Moments& m) {
+  wavog::NdtCell c;
+  c.weight = m.w;
+  c.mean_x = m.x / m.w;
+  c.mean_y = m.y / m.w;
+  c.cov_xx = m.xx / m.w - c.mean_x * c.mean_x;
+  c.cov_xy = m.xy / m.w - c.mean_x * c.mean_y;
+  c.cov_yy = m.yy / m.w - c.mean_y * c.mean_y;
+  return c;
+}
+
+bool DenseReference::ndtCell(std::int64_t ix, std::int64_t iy, wavog::NdtCell* out) const {
+  const auto it = ndt_.find({iy, ix});
+  if (it == ndt_.end()) return false;
+  *out = gaussian(it->second);
+  out->ix = ix;
+  out->iy = iy;
+  return true;
+}
+
+std::vector<wavog::NdtCell> DenseReference::ndtLayer(int s, const wavog::CellBox& window) const {
+  std::map<std::pair<std::int64_t, std::int64_t>, Moments> merged;
+  for (const auto& kv : ndt_) {
+    const std::int64_t cx = kv.first.second >> s, cy = kv.first.first >> s;
+    if (cx < window.min_x || cx >= window.max_x || cy < window.min_y || cy >= window.max_y) continue;
+    Moments& m = merged[{cy, cx}];
+    m.w += kv.second.w;
+    m.x += kv.second.x;
+    m.y += kv.second.y;
+    m.xx += kv.second.xx;
+    m.xy += kv.second.xy;
+    m.yy += kv.second.yy;
+  }
+  std::vector<wavog::NdtCell> out;
+  for (const auto& kv : merged) {
+    wavog::NdtCell c = gaussian(kv.second);
+    c.ix = kv.first.second;
+    c.iy = kv.first.first;
+    out.push_back(c);
+  }
+  return out;
 }
 
 double DenseReference::blockMean(int s, std::int64_t bx, std::int64_t by) const {

@@ -5,12 +5,14 @@
 #define WAVOG_MAPPING_TEST_CORE_DENSE_REFERENCE_H_
 
 #include <cstdint>
+#include <map>
 #include <set>
 #include <utility>
 #include <vector>
 
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/types.h"
+#include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog_test {
 
@@ -22,6 +24,9 @@ class ReferenceClassifier {
   bool prepare(const wavog::MapParams& p, const wavog::Pose2& pose, const wavog::ScanView& scan);
   /// E, O or U of finest cell (ix, iy).
   wavog::CellClass cellClass(std::int64_t ix, std::int64_t iy) const;
+  /// The map-frame end-points of the hit beams, in ascending bearing order.
+  std::vector<std::pair<double, double>> endpoints(const wavog::Pose2& pose,
+                                                   const wavog::ScanView& scan) const;
   /// Largest band end of the valid beams (m): every cell beyond is U.
   double reach() const { return reach_; }
 
@@ -59,12 +64,21 @@ class DenseReference {
   double blockMaxObserved(int s, std::int64_t bx, std::int64_t by) const;
   bool blockAnyKnown(int s, std::int64_t bx, std::int64_t by) const;
 
+  /// MapParams::ndt of layer 0: the Gaussian of finest cell (ix, iy), false when it holds none.
+  bool ndtCell(std::int64_t ix, std::int64_t iy, wavog::NdtCell* out) const;
+  /// The Gaussians of the scale-s cells in `window` (scale-s units), sorted by (iy, ix), merged
+  /// from the map-frame moment sums of their finest cells.
+  std::vector<wavog::NdtCell> ndtLayer(int s, const wavog::CellBox& window) const;
+  std::size_t ndtCells() const { return ndt_.size(); }
+
   /// Cells changed by the last scan (for tests of the update footprint).
   std::size_t lastUpdatedCells() const { return last_updated_; }
 
  private:
   std::size_t index(std::int64_t ix, std::int64_t iy) const;
   static double apply(const wavog::MapParams& p, bool occupied, double x);
+  void integrateNdt(const ReferenceClassifier& ref, const wavog::Pose2& pose,
+                    const wavog::ScanView& scan);
 
   std::vector<wavog::MapParams> layers_;
   wavog::MapParams p_;  // geometry shared by the layers
@@ -72,6 +86,13 @@ class DenseReference {
   std::size_t layer_ = 0;
   std::vector<std::vector<double>> v_;
   std::vector<std::uint8_t> known_;
+  /// Map-frame moment sums of the end-points of each cell holding a Gaussian:
+  /// w, sum w x, sum w y, sum w x^2, sum w x y, sum w y^2.
+  struct Moments {
+    double w = 0, x = 0, y = 0, xx = 0, xy = 0, yy = 0;
+  };
+  std::map<std::pair<std::int64_t, std::int64_t>, Moments> ndt_;  // keyed (iy, ix)
+  static wavog::NdtCell gaussian(const Moments& m);
   std::size_t last_updated_ = 0;
 };
 

@@ -106,12 +106,14 @@ std::vector<NamedParams> configurations(double res, int block_levels) {
     pruned.params.skip_tolerance = 0.01;
     out.push_back(pruned);
   }
-  // The payloads: reflection layers (saved in the file) and forgetting in seconds.
+  // The payloads: reflection layers and normal-distribution cells (saved in the file) and
+  // forgetting in seconds.
   for (const auto& base : everyPolicy(res, block_levels)) {
     if (base.name != "forget" && base.name != "none" && base.name != "max") continue;
     NamedParams reflection = base;
-    reflection.name = base.name + "_reflection";
+    reflection.name = base.name + "_reflection_ndt";
     reflection.params.reflection = true;
+    reflection.params.ndt = true;
     if (base.name == "forget") reflection.params.policy.forget_half_life = 0.2;
     out.push_back(reflection);
   }

@@ -65,6 +65,7 @@ MapParams decodeParams(FuzzedDataProvider* in, bool oracle) {
   p.policy.init = in->ConsumeBool() ? wavog::InitValue::kEmptyBound : wavog::InitValue::kUnknown;
   p.lazy_forgetting = in->ConsumeBool();
   p.reflection = in->ConsumeBool();
+  p.ndt = in->ConsumeBool();
   if (oracle) {
     p.grid.resolution = pick(in, {0.05, 0.1, 0.2, 0.15});
     p.grid.block_levels = in->ConsumeIntegralInRange<int>(2, 5);

@@ -5,7 +5,9 @@
 // reach the parser behind the checksum; clear: the rest is the file as it is. Bits 1-2: the
 // loading map's policy (clamp, or forgetting with one of three gammas, so a file's pending
 // forgetting tags are sometimes applied while loading). Bit 3: the framed version is 1 (u8
-// pending counts) instead of 2. Bit 4: forgetting with forget_half_life (16-bit pending units).
+// pending counts) instead of 3. Bit 4: forgetting with forget_half_life (16-bit pending units).
+// Bit 5: the loading map keeps normal-distribution cells (MapParams::ndt); with bit 6 and not
+// bit 3 the framed version is 2 (no NDT section).
 #include <zlib.h>
 
 #include <cmath>
@@ -45,6 +47,7 @@ MapParams paramsFor(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
   static const double kGamma[] = {0.3, 0.3, 0.5, 1.0};
   p.policy.gamma = kGamma[policy];
   if (policy != 0 && (mode & 16)) p.policy.forget_half_life = 0.3;
+  p.ndt = (mode & 32) != 0;
   if (file.size() >= 24) {
     MapParams q = p;
     std::memcpy(&q.grid.resolution, file.data() + 12, sizeof(double));
@@ -62,7 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t mode = data[0];
   const std::vector<std::uint8_t> file = (mode & 1)
-                                             ? frame(data + 1, size - 1, (mode & 8) ? 1 : 2)
+                                             ? frame(data + 1, size - 1, (mode & 8) ? 1 : (mode & 64) ? 2 : 3)
                                              : std::vector<std::uint8_t>(data + 1, data + size);
   const MapParams params = paramsFor(file, mode);
   static const std::string path = wavog_fuzz::scratchPath("load.wavog");

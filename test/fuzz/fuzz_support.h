@@ -132,6 +132,24 @@ inline std::vector<wavog::Raster> readOutEveryScale(const wavog::WaveletMap& map
         WAVOG_FUZZ_CHECK((grid[i] == -1) == std::isnan(r.p[i]), "reflection grid %d", grid[i]);
       }
     }
+    if (map.params().ndt) {
+      // Every Gaussian in the window, with a positive weight, its mean in its cell and a
+      // covariance with a non-negative diagonal.
+      const wavog::NdtLayer layer = map.exportNdt(s, box);
+      for (const wavog::NdtCell& c : layer.cells) {
+        WAVOG_FUZZ_CHECK(c.ix >= box.min_x && c.ix < box.max_x && c.iy >= box.min_y &&
+                             c.iy < box.max_y,
+                         "NDT cell outside the window at scale %d", s);
+        WAVOG_FUZZ_CHECK(c.weight > 0.0 && std::isfinite(c.mean_x) && std::isfinite(c.mean_y) &&
+                             c.cov_xx >= 0.0 && c.cov_yy >= 0.0 && std::isfinite(c.cov_xy),
+                         "NDT cell weight %g cov %g %g", c.weight, c.cov_xx, c.cov_yy);
+        const double lo = static_cast<double>(c.ix) * layer.cell_size;
+        WAVOG_FUZZ_CHECK(c.mean_x >= lo - 1e-6 * layer.cell_size &&
+                             c.mean_x <= lo + layer.cell_size * (1.0 + 1e-6),
+                         "NDT mean %g outside its cell [%g, %g)", c.mean_x, lo,
+                         lo + layer.cell_size);
+      }
+    }
   }
   return out;
 }
