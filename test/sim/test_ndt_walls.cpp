@@ -72,10 +72,13 @@ TEST(NdtWallDistance, CellCentresAndMeansOfHandMadeCellsBesideAKnownWall) {
   EXPECT_NEAR(d.ndt_cell_centre_m, 0.02, 1e-9);
   EXPECT_NEAR(d.ndt_mean_m, 0.005, 1e-9);
 
-  // Nothing to average: NaN, and Gaussians of another cell size are refused.
-  const NdtWallDistance none = ndtWallDistance(world, 0.0, map, NdtLayer{}, 0.01);
+  // Nothing occupied, nothing to average: NaN. Gaussians of another cell size are refused.
+  Raster free_map = map;
+  free_map.log_odds.assign(400, -1.0f);
+  const NdtWallDistance none = ndtWallDistance(world, 0.0, free_map, ndt, 0.5);
   EXPECT_EQ(none.cells, 0u);
   EXPECT_TRUE(std::isnan(none.cell_centre_m));
+  EXPECT_EQ(none.gaussians, 0u);
   EXPECT_TRUE(std::isnan(none.ndt_mean_m));
   ndt.cell_size = 0.2;
   EXPECT_THROW(ndtWallDistance(world, 0.0, map, ndt, 0.5), std::invalid_argument);
