@@ -33,6 +33,7 @@ target_compile_options(wavog_sim_eval PRIVATE ${WAVOG_WARNINGS})
 wavog_sim_test(test_simulator wavog_sim)
 wavog_sim_test(test_policy_response wavog_sim_eval)
 wavog_sim_test(test_pose_noise wavog_sim_eval)
+wavog_sim_test(test_ndt_walls wavog_sim_eval)
 
 # ---- wavog_simulate: scenario -> rosbag (rosbag C++ API, no roscore) --------------------------
 set(WAVOG_SIM_BIN_DIR ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -42,6 +42,7 @@ wavog_tools_test(test_image_io)
 find_package(Python3 COMPONENTS Interpreter REQUIRED)
 target_compile_definitions(test_image_io PRIVATE WAVOG_PYTHON="${Python3_EXECUTABLE}")
 wavog_tools_test(test_tool_support)
+wavog_tools_test(test_ndt_image)
 
 if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_log2bag.cpp)
   wavog_tools_test(test_log2bag)

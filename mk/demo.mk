@@ -6,8 +6,9 @@
 #   map/                 wavog_offline with config/default.yaml: map_s<scale>.png/.pgm/.yaml
 #                        (scales 0, 2, 3, 4), snapshots/ every 15 s, map.wavog, summary.json
 #                        (through the core directly when wavog_offline is not built)
-#   report.md, summary.json, figure_data/   wavog_evaluate (the figures' data: maps, CSV)
-#   policies.png, departure.png, arrival.png   scripts/plot_evaluation.py (matplotlib)
+#   report.md, summary.json, figure_data/   wavog_evaluate --ndt (the figures' data: maps, CSV)
+#   policies.png, departure.png, arrival.png, ndt_wall_distance.png   scripts/plot_evaluation.py
+#                        (matplotlib); --ndt adds a few % of CPU time (63.0 s user without, 63.1-65.2 s with)
 # About 1-2 minutes after the build on 2 cores.
 DEMO_OUT ?= $(ROOT)/demo_output
 DEMO_SEED ?= 1
@@ -32,14 +33,15 @@ demo: deps $(BUILD)/CMakeCache.txt
 	  offline_summary="--offline-summary $(DEMO_OUT)/map/summary.json"; \
 	else core_maps="--core-maps $(DEMO_OUT)/map"; fi; \
 	echo "demo: [3/3] evaluating every update policy against the ground truth"; \
-	$(DEMO_BIN)/wavog_evaluate --seed $(DEMO_SEED) --out $(DEMO_OUT) $$core_maps $$offline_summary; \
+	$(DEMO_BIN)/wavog_evaluate --seed $(DEMO_SEED) --ndt --out $(DEMO_OUT) $$core_maps $$offline_summary; \
 	/usr/bin/python3 $(ROOT)/scripts/plot_evaluation.py $(DEMO_OUT); \
 	echo; echo "demo: done in $$(( $$(date +%s) - start )) s (after the build). Outputs in $(DEMO_OUT)/:"; \
 	echo "  report.md             the policy comparison table (also summary.json)"; \
 	echo "  policies.png          final maps of every policy side by side"; \
 	echo "  departure.png         a departed car's occupancy against time, per policy"; \
 	echo "  arrival.png           an arrived car's occupancy against time, per policy"; \
-	echo "  figure_data/          the figures' data (final map per policy, responses.csv; scripts/plot_evaluation.py)"; \
+	echo "  ndt_wall_distance.png per policy, how far from the true walls the occupied cells' centres and the NDT means lie"; \
+	echo "  figure_data/          the figures' data (final map per policy, responses.csv, ndt_wall_distance.csv; scripts/plot_evaluation.py)"; \
 	echo "  map/map_s*.png        the default (forgetting) map at scales 0, 2, 3, 4 (+ PGM/YAML)"; \
 	echo "  scenario.bag          the simulated rosbag (rosbag play it to the node)"; \
 	echo "  world.yaml, ground_truth/   the scenario and its true occupancy"

@@ -10,6 +10,10 @@ Reads DIR/figure_data/figures.json, DIR/figure_data/maps/*.png and DIR/figure_da
   arrival.png     the same for the arrived car (further events: departure_<k>.png, ...)
   reflection_departure.png, reflection_arrival.png
                   with wavog_evaluate --reflection: the cars' mean reflection p the same way
+  ndt_wall_distance.png
+                  with wavog_evaluate --ndt (figure_data/ndt_wall_distance.csv): per policy the
+                  mean distance to the true walls of the occupied cells' centres, of the centres
+                  of those holding a Gaussian, and of their NDT means
 Needs matplotlib (Debian: python3-matplotlib); `make demo` runs it.
 """
 
@@ -107,6 +111,38 @@ def plot_event(k, event, figures, series, out_path, quantity="P(occupied)"):
     plt.close(fig)
 
 
+def plot_ndt(csv_path, resolution, out_path):
+    with open(csv_path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    bars = [("cell_centre_m", "occupied cells' centres", "#7f7f7f"),
+            ("ndt_cell_centre_m", "centres of the cells with a Gaussian", "#56b4e9"),
+            ("ndt_mean_m", "NDT means of those cells", "#d55e00")]
+    width = 0.8 / len(bars)
+    fig, ax = plt.subplots(figsize=(max(7.0, 1.3 * len(rows) + 3.0) + 3.5, 4.8),
+                           constrained_layout=True)
+    top = 0.0
+    for j, (key, label, colour) in enumerate(bars):
+        xs = [i + (j - (len(bars) - 1) / 2.0) * width for i in range(len(rows))]
+        values = [100.0 * float(r[key]) for r in rows]  # "nan" where nothing was averaged
+        top = max([top] + [v for v in values if math.isfinite(v)])
+        ax.bar(xs, values, width, label=label, color=colour)
+    ax.set_ylim(0.0, 1.15 * max(top, 50.0 * resolution if resolution else 0.0, 1.0))
+    if resolution:
+        ax.axhline(50.0 * resolution, color="0.35", linestyle="--", linewidth=1)
+        ax.annotate("half a cell", xy=(len(rows) - 0.5, 50.0 * resolution), xytext=(-4, 4),
+                    textcoords="offset points", ha="right", color="0.35")
+    ax.set_xticks(range(len(rows)))
+    ax.set_xticklabels([r["policy"] for r in rows], rotation=20, ha="right")
+    ax.set_xlim(-0.6, len(rows) - 0.4)
+    ax.set_ylabel("mean distance to the true walls (cm)")
+    ax.set_title("Where the map puts the walls: cell centres against NDT means%s"
+                 % (" (%.0f cm cells)" % (100.0 * resolution) if resolution else ""))
+    ax.grid(True, axis="y", color="0.9")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    fig.savefig(out_path, dpi=DPI)
+    plt.close(fig)
+
+
 def draw(out_dir):
     data_dir = os.path.join(out_dir, "figure_data")
     figures, series, reflection = load(data_dir)
@@ -118,6 +154,15 @@ def draw(out_dir):
         if any(key[0] == k for key in reflection):
             written.append(os.path.join(out_dir, "reflection_" + event["figure"]))
             plot_event(k, event, figures, reflection, written[-1], "reflection p")
+    ndt_csv = os.path.join(data_dir, "ndt_wall_distance.csv")
+    if os.path.exists(ndt_csv):  # wavog_evaluate --ndt
+        resolution = None
+        summary = os.path.join(out_dir, "summary.json")
+        if os.path.exists(summary):
+            with open(summary) as f:
+                resolution = json.load(f).get("resolution")
+        written.append(os.path.join(out_dir, "ndt_wall_distance.png"))
+        plot_ndt(ndt_csv, resolution, written[-1])
     return written
 
 

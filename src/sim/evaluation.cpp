@@ -300,8 +300,14 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
     }
   }
   result.wall_distance = n ? sum / static_cast<double>(n) : 0.0;
+  if (run.params.ndt) {
+    result.ndt_walls =
+        ndtWallDistance(world, t_end, result.final_map, map.exportNdt(0, box), options.wall_margin);
+  }
 
   const MapStats stats = map.stats(true);
+  result.ndt_cells = stats.ndt_cells;
+  result.ndt_bytes = stats.ndt_bytes;
   result.nodes = stats.nodes;
   result.bytes = stats.bytes;
   result.observed_cells = stats.observed_cells;

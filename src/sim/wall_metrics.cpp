@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
 #include "wavog_mapping/sim/ground_truth.h"
@@ -24,6 +25,56 @@ long long indexAt(const Raster& r, const Vec2& p) {
   const auto iy = static_cast<std::int64_t>(std::floor(p.y() / r.cell_size)) - r.box.min_y;
   if (ix < 0 || iy < 0 || ix >= r.box.width() || iy >= r.box.height()) return -1;
   return iy * r.box.width() + ix;
+}
+
+// The raster's cells as a ground-truth window.
+GridWindow windowOf(const Raster& map) {
+  GridWindow window;
+  window.resolution = map.cell_size;
+  window.min_x = map.box.min_x;
+  window.min_y = map.box.min_y;
+  window.width = static_cast<int>(map.box.width());
+  window.height = static_cast<int>(map.box.height());
+  return window;
+}
+
+// The map's occupied cells: observed, log-odds above 1e-3 (above the unknown value's round-off).
+bool occupied(const Raster& map, std::size_t i) { return map.known[i] && map.log_odds[i] > 1e-3f; }
+
+// 1 where a cell lies within `margin_m` of a wall present at t and nearer to a wall than to any
+// other object (so that cars parked against a wall do not count as the wall).
+std::vector<std::uint8_t> nearWalls(const World& world, double t, const GridWindow& window,
+                                    double margin_m) {
+  const std::vector<std::uint8_t> walls = occupancyAt(world, t, window, TruthFilter::kWallsOnly);
+  const std::vector<float> to_wall = distanceTransform(walls, window);
+  std::vector<std::uint8_t> others = occupancyAt(world, t, window, TruthFilter::kAll);
+  for (std::size_t i = 0; i < others.size(); ++i) others[i] = others[i] && !walls[i];
+  const std::vector<float> to_other = distanceTransform(others, window);
+  std::vector<std::uint8_t> near(window.size(), 0);
+  for (std::size_t i = 0; i < window.size(); ++i) {
+    near[i] = to_wall[i] <= margin_m && to_wall[i] < to_other[i];
+  }
+  return near;
+}
+
+// World-frame polygons of the walls present at t.
+std::vector<Polygon> wallPolygons(const World& world, double t) {
+  std::vector<Polygon> walls;
+  for (const WorldObject& o : world.objects) {
+    if (o.kind == ObjectKind::kWall && o.presentAt(t)) walls.push_back(o.polygonAt(t));
+  }
+  return walls;
+}
+
+// Distance from p to the nearest edge of the polygons (+inf without any).
+double distanceToEdges(const std::vector<Polygon>& polygons, const Vec2& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Polygon& poly : polygons) {
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      best = std::min(best, pointSegmentDistance(p, poly[i], poly[(i + 1) % poly.size()]));
+    }
+  }
+  return best;
 }
 
 bool insideAny(const std::vector<Polygon>& polygons, const Vec2& p) {
@@ -181,30 +232,61 @@ WallWidth wallWidthAtHalfMax(const Raster& map, const std::vector<WallSample>& s
 
 double meanDistanceToWallSurface(const World& world, double t, const Raster& map, double margin_m,
                                  std::size_t* cells) {
-  GridWindow window;
-  window.resolution = map.cell_size;
-  window.min_x = map.box.min_x;
-  window.min_y = map.box.min_y;
-  window.width = static_cast<int>(map.box.width());
-  window.height = static_cast<int>(map.box.height());
+  const GridWindow window = windowOf(map);
   const std::vector<float> to_surface =
       distanceTransform(surfaceAt(world, t, window, TruthFilter::kWallsOnly), window);
-  const std::vector<std::uint8_t> walls = occupancyAt(world, t, window, TruthFilter::kWallsOnly);
-  const std::vector<float> to_wall = distanceTransform(walls, window);
-  std::vector<std::uint8_t> others = occupancyAt(world, t, window, TruthFilter::kAll);
-  for (std::size_t i = 0; i < others.size(); ++i) others[i] = others[i] && !walls[i];
-  const std::vector<float> to_other = distanceTransform(others, window);
+  const std::vector<std::uint8_t> near = nearWalls(world, t, window, margin_m);
   double sum = 0.0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < window.size(); ++i) {
-    if (!map.known[i] || !(map.log_odds[i] > 1e-3f)) continue;
-    if (to_wall[i] <= margin_m && to_wall[i] < to_other[i]) {
-      sum += to_surface[i];
-      ++n;
-    }
+    if (!occupied(map, i) || !near[i]) continue;
+    sum += to_surface[i];
+    ++n;
   }
   if (cells) *cells = n;
   return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+double distanceToWallEdges(const World& world, double t, const Vec2& p) {
+  return distanceToEdges(wallPolygons(world, t), p);
+}
+
+NdtWallDistance ndtWallDistance(const World& world, double t, const Raster& map,
+                                const NdtLayer& ndt, double margin_m) {
+  NdtWallDistance d;
+  if (!ndt.cells.empty() && !(std::fabs(ndt.cell_size - map.cell_size) <= 1e-9 * map.cell_size)) {
+    throw std::invalid_argument("ndtWallDistance: Gaussians of another cell size than the map's");
+  }
+  const GridWindow window = windowOf(map);
+  const std::vector<std::uint8_t> near = nearWalls(world, t, window, margin_m);
+  const std::vector<Polygon> walls = wallPolygons(world, t);  // once, not per point
+  double centres = 0.0;
+  for (std::size_t i = 0; i < window.size(); ++i) {
+    if (!occupied(map, i) || !near[i]) continue;
+    const int col = static_cast<int>(i % static_cast<std::size_t>(window.width));
+    const int row = static_cast<int>(i / static_cast<std::size_t>(window.width));
+    centres += distanceToEdges(walls, window.centre(col, row));
+    ++d.cells;
+  }
+  if (d.cells > 0) d.cell_centre_m = centres / static_cast<double>(d.cells);
+  double ndt_centres = 0.0;
+  double means = 0.0;
+  for (const NdtCell& c : ndt.cells) {
+    const std::int64_t col = c.ix - map.box.min_x;
+    const std::int64_t row = c.iy - map.box.min_y;
+    if (col < 0 || row < 0 || col >= map.box.width() || row >= map.box.height()) continue;
+    const auto i = static_cast<std::size_t>(row * map.box.width() + col);
+    if (!occupied(map, i) || !near[i]) continue;
+    ndt_centres +=
+        distanceToEdges(walls, window.centre(static_cast<int>(col), static_cast<int>(row)));
+    means += distanceToEdges(walls, Vec2(c.mean_x, c.mean_y));
+    ++d.gaussians;
+  }
+  if (d.gaussians > 0) {
+    d.ndt_cell_centre_m = ndt_centres / static_cast<double>(d.gaussians);
+    d.ndt_mean_m = means / static_cast<double>(d.gaussians);
+  }
+  return d;
 }
 
 }  // namespace sim

@@ -1,8 +1,9 @@
 // wavog_evaluate: runs a simulated scenario (default: the car park) through the core map under
 // every update policy and compares the maps with the ground truth. Writes report.md (the table),
-// summary.json and figure_data/ (final maps and a car's mean occupancy against time per policy),
-// from which scripts/plot_evaluation.py draws policies.png (final maps side by side, as the
-// paper's Fig. 1.2), departure.png and arrival.png. No ROS needed to run.
+// summary.json and figure_data/ (final maps and a car's mean occupancy against time per policy;
+// with --ndt the walls' distances of cell centres and NDT means), from which
+// scripts/plot_evaluation.py draws policies.png (final maps side by side, as the paper's Fig.
+// 1.2), departure.png, arrival.png (and ndt_wall_distance.png). No ROS needed to run.
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -46,7 +47,8 @@ struct Options {
   std::string offline_summary;        // JSON file embedded as "offline_map" in summary.json
   std::string core_maps;              // also map with the default forgetting config, PNGs here
   std::string pose_noise = "0:0,2:0.2,5:0.5";  // noise study levels (cm:deg); "none": skip
-  bool reflection = false;                      // every run also keeps the reflection map
+  bool reflection = false;                     // every run also keeps the reflection map
+  bool ndt = false;                            // every run also keeps NDT cells
 };
 
 /// What --help says first.
@@ -73,6 +75,12 @@ void addOptions(CLI::App* app, Options* o) {
   app->add_flag("--reflection", o->reflection,
                 "every run also keeps the reflection map; the cars' mean reflection p goes into "
                 "figure_data/responses.csv (plot_evaluation.py draws reflection_*.png)");
+  app->add_flag("--ndt", o->ndt,
+                "every run (but the pose-noise study's) also keeps normal-distribution cells; "
+                "the mean distance to the true walls of the NDT means against that of the "
+                "occupied cells' centres goes into the table and "
+                "figure_data/ndt_wall_distance.csv (plot_evaluation.py draws "
+                "ndt_wall_distance.png)");
   app->add_option("--offline-summary", o->offline_summary,
                   "embed this JSON (wavog_offline's summary) in summary.json");
   app->add_option("--core-maps", o->core_maps,
@@ -127,17 +135,37 @@ void printHeadline(const std::vector<WorldEvent>& events,
               << (e.type == WorldEvent::Type::kDeparture ? "departed car free"
                                                          : "arrived car occ.");
   }
-  std::cout << std::setw(11) << "precision" << std::setw(10) << "wall cm" << std::setw(10)
-            << "B/cell"
+  const bool ndt = !results.empty() && results.front().params.ndt;
+  std::cout << std::setw(11) << "precision" << std::setw(10) << "wall cm";
+  if (ndt) std::cout << std::setw(13) << "centres cm" << std::setw(10) << "NDT cm";
+  std::cout << std::setw(10) << "B/cell"
             << "us/scan\n";
   for (const PolicyResult& r : results) {
     std::cout << std::setw(26) << r.label;
     for (const EventResponse& e : r.events) std::cout << std::setw(24) << responseText(e);
     std::cout << std::setw(11) << fixed(r.precision, 3) << std::setw(10)
-              << fixed(100 * r.wall_distance, 1) << std::setw(10)
-              << fixed(r.bytes_per_observed_cell, 2) << fixed(r.mean_scan_us, 0) << "\n";
+              << fixed(100 * r.wall_distance, 1);
+    if (ndt) {
+      std::cout << std::setw(13) << fixed(100 * r.ndt_walls.cell_centre_m, 2) << std::setw(10)
+                << fixed(100 * r.ndt_walls.ndt_mean_m, 2);
+    }
+    std::cout << std::setw(10) << fixed(r.bytes_per_observed_cell, 2) << fixed(r.mean_scan_us, 0)
+              << "\n";
   }
   std::cout << std::right << std::flush;
+}
+
+// A result as the same run without NDT cells would give it: the Gaussians' bytes and figures out.
+PolicyResult withoutNdt(PolicyResult r) {
+  if (!r.params.ndt) return r;
+  r.params.ndt = false;
+  r.bytes -= r.ndt_bytes;
+  r.bytes_per_observed_cell =
+      r.observed_cells ? static_cast<double>(r.bytes) / static_cast<double>(r.observed_cells) : 0.0;
+  r.ndt_walls = NdtWallDistance();
+  r.ndt_cells = 0;
+  r.ndt_bytes = 0;
+  return r;
 }
 
 // The pose-error study (noise_study.h) over the paper's four policies, appended to report.md.
@@ -151,8 +179,12 @@ void runPoseNoiseStudy(const World& world, const std::vector<SimScan>& scans,
   for (std::size_t i = 0; i < runs.size(); ++i) {
     if (runs[i].params.policy.init == wavog::InitValue::kUnknown &&
         runs[i].params.policy.type != wavog::PolicyType::kClampLower) {
+      // The study measures occupancy alone: with --ndt its runs keep no Gaussians, and level 0
+      // (today's runs) counts its bytes without theirs (a map's other bytes do not depend on
+      // them), so that every level is comparable; NDT would cost a third more time here.
       paper_runs.push_back(runs[i]);
-      exact.push_back(results[i]);
+      paper_runs.back().params.ndt = false;
+      exact.push_back(withoutNdt(results[i]));
     }
   }
   if (paper_runs.empty()) return;
@@ -196,7 +228,10 @@ int run(const Options& o) {
     for (const std::string& p : o.policies) keep = keep || r.label.rfind(p, 0) == 0;
     if (keep) runs.push_back(r);
   }
-  for (PolicyRun& r : runs) r.params.reflection = o.reflection;
+  for (PolicyRun& r : runs) {
+    r.params.reflection = o.reflection;
+    r.params.ndt = o.ndt;
+  }
   if (runs.empty()) throw std::invalid_argument("no policy matches --policy");
   EvaluationOptions eo;
   eo.fraction = o.fraction;
@@ -231,6 +266,7 @@ int run(const Options& o) {
   info.fraction = o.fraction;
   info.jobs = o.jobs;
   info.scans = scans.size();
+  info.ndt = o.ndt;
   std::ofstream(fs::path(o.out_dir) / "report.md") << report(world, info, events, results);
   const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   wavog_tools::writeJson((fs::path(o.out_dir) / "summary.json").string(),

@@ -22,6 +22,7 @@ struct RunInfo {
   double fraction = 0.9;
   int jobs = 2;
   std::size_t scans = 0;
+  bool ndt = false;  ///< --ndt: the runs kept NDT cells
 };
 
 /// `v` with `digits` decimals.
@@ -46,8 +47,9 @@ nlohmann::ordered_json summary(const wavog::sim::World& world, const RunInfo& ru
 std::string figureName(const std::vector<wavog::sim::WorldEvent>& events, std::size_t k);
 
 /// Writes `dir`/figure_data/: figures.json (titles, events, each map's PNG and extent in m),
-/// maps/policy_<i>.png (final maps, halved with the largest value so thin walls stay visible)
-/// and responses.csv (event, policy, time_s, mean_p_occ).
+/// maps/policy_<i>.png (final maps, halved with the largest value so thin walls stay visible),
+/// responses.csv (event, policy, time_s, mean_p_occ, mean_reflection_p) and, when the runs kept
+/// NDT cells, ndt_wall_distance.csv (policy, the distances of ndtWallDistance in m, the counts).
 void writeFigureData(const std::string& dir, const wavog::sim::World& world,
                      const std::vector<wavog::sim::WorldEvent>& events,
                      const std::vector<wavog::sim::PolicyResult>& results, double t_end);

@@ -4,7 +4,8 @@
 // conversions (scan checks, mirrored lasers, motion compensation over the sweep). CARMEN logs: the
 // logged (corrected) laser poses are used as they are. The parameters come from the node's YAML
 // through the one loader (wavog_ros::configFromXmlRpc). Writes per scale a PNG, a map_server PGM +
-// YAML, the native map, summary.json and optional snapshots.
+// YAML (the same of the reflection map, and an NDT picture, when kept), the native map,
+// summary.json and optional snapshots.
 #include "offline.h"
 
 #include <rosbag/bag.h>
@@ -39,6 +40,7 @@
 #include "wavog_mapping/io/carmen_reader.h"
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/io/map_files.h"
+#include "wavog_mapping/io/ndt_image.h"
 #include "wavog_mapping/ros/config.h"
 #include "wavog_mapping/ros/conversions.h"
 #include "wavog_mapping/ros/scan_placement.h"
@@ -63,7 +65,8 @@ std::vector<int> parseScales(const std::string& text) {
 constexpr const char* kDescription =
     "Maps INPUT, a rosbag (LaserScan + /tf, /tf_static) or a CARMEN log (plain or .gz), without "
     "a roscore, and writes to the output folder: map_s<scale>.png (unknown in pale blue), "
-    "map_s<scale>.pgm + .yaml (map_server), map.wavog (native map), summary.json.";
+    "map_s<scale>.pgm + .yaml (map_server), map.wavog (native map), summary.json (with "
+    "--reflection also reflection_s<scale>.*, with --ndt ndt_s<scale>.png).";
 
 /// The command line of wavog_offline (its --help is generated from these).
 void addOptions(CLI::App* app, Options* o) {
@@ -100,6 +103,9 @@ void addOptions(CLI::App* app, Options* o) {
   app->add_flag("--reflection", o->reflection,
                 "also keep the reflection probability map (reflection: true) and write "
                 "reflection_s<scale>.png / .pgm / .yaml");
+  app->add_flag("--ndt", o->ndt,
+                "also keep normal-distribution cells (ndt: true) and write ndt_s<scale>.png: the "
+                "map with each Gaussian's 2-sigma ellipse and its mean");
   app->add_flag_callback(
       "--no-progress", [o] { o->progress = false; }, "no progress bar");
   app->add_flag_callback(
@@ -139,7 +145,11 @@ wavog_ros::Config loadConfig(const Options& o, std::vector<std::string>* unknown
   if (o.reflection) root["reflection"] = true;
   if (!o.aggregation.empty()) root["scale_aggregation"] = o.aggregation;
   try {
-    return wavog_ros::configFromXmlRpc(root, unknown);
+    wavog_ros::Config config = wavog_ros::configFromXmlRpc(root, unknown);
+    // Set here rather than in the tree: a flag needs no validation, and the YAML's `ndt` key is
+    // read by the node's loader where it knows it.
+    if (o.ndt) config.map.ndt = true;
+    return config;
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument((o.config.empty() ? std::string("options") : o.config) + ": " +
                                 e.what());
@@ -163,8 +173,24 @@ wavog::Raster reflectionAsRaster(const wavog::ReflectionRaster& r) {
   return out;
 }
 
+/// The NDT picture of one scale over its occupancy raster, and its entry of summary.json: the
+/// number of Gaussians, their mean weight and the picture's pixels per cell.
+Json writeNdt(const Options& o, const wavog::WaveletMap& map, const wavog::Raster& raster) {
+  const wavog::NdtLayer layer = map.exportNdt(raster.scale, raster.box);
+  const wavog::NdtRenderOptions options;
+  const std::string png = wavog::scaleFileBase("ndt", raster.scale) + ".png";
+  wavog::writePng((fs::path(o.out) / png).string(), wavog::renderNdt(raster, layer, options));
+  double weight = 0.0;
+  for (const wavog::NdtCell& c : layer.cells) weight += c.weight;
+  return {
+      {"png", png},
+      {"gaussians", layer.cells.size()},
+      {"mean_weight", layer.cells.empty() ? 0.0 : weight / static_cast<double>(layer.cells.size())},
+      {"upscale", wavog::ndtUpscale(raster.box.width(), raster.box.height(), options)}};
+}
+
 /// Per scale: a PNG and a map_server map, cropped to the observed part (and the same of the
-/// reflection map, when kept); their entries of summary.json's "scales".
+/// reflection map and the NDT picture, when kept); their entries of summary.json's "scales".
 Json writeScales(const Options& o, const wavog_ros::Config& config, Session* session) {
   Json scales = Json::array();
   wavog::WaveletMap* map = &session->map();
@@ -199,6 +225,7 @@ Json writeScales(const Options& o, const wavog_ros::Config& config, Session* ses
                              {"yaml", rbase + ".yaml"},
                              {"cells_p_at_least_half", reflecting}};
     }
+    if (config.map.ndt) entry["ndt"] = writeNdt(o, *map, raster);
     scales.push_back(entry);
   }
   return scales;
@@ -253,7 +280,12 @@ Json summaryOf(const Options& o, const wavog_ros::Config& config, const InputInf
                     {"bytes", stats.bytes},
                     {"observed_cells", stats.observed_cells},
                     {"bytes_per_observed_cell", bytesPerCell(stats)}};
+  if (config.map.ndt) {
+    summary["map"]["ndt_cells"] = stats.ndt_cells;
+    summary["map"]["ndt_bytes"] = stats.ndt_bytes;
+  }
   summary["native_map"] = "map.wavog";
+  summary["ndt"] = config.map.ndt;
   return summary;
 }
 

@@ -37,8 +37,9 @@ struct Options {
   double snapshot_every = 0.0;
   bool progress = true;
   bool quiet = false;
-  int threads = -1;  // -1: the YAML's num_threads
+  int threads = -1;         // -1: the YAML's num_threads
   bool reflection = false;  // --reflection (else the YAML's)
+  bool ndt = false;         // --ndt (else the YAML's)
 };
 
 /// Counts, snapshots and progress around WaveletMap::integrate, shared by both inputs.

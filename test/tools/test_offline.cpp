@@ -1,8 +1,10 @@
 // Tests of wavog_offline, run as a program: the map from a converted fr079 bag equals the core map
 // from the log read directly; the CARMEN log maps directly; outputs (PNG, PGM + YAML, native map,
-// summary.json, snapshots) are written and consistent; the real laser_scan_matcher_demo.bag (no tf,
-// frame "/laser") maps with --fixed-frame laser and its zero readings are rejected (REP 117); clear
-// errors for a missing file, a missing topic and tf that never connects.
+// summary.json, snapshots) are written and consistent; with --ndt the NDT pictures have the
+// expected size and summary.json's Gaussian counts equal the core's; the real
+// laser_scan_matcher_demo.bag (no tf, frame "/laser") maps with --fixed-frame laser and its zero
+// readings are rejected (REP 117); clear errors for a missing file, a missing topic and tf that
+// never connects.
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -26,6 +28,7 @@
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
 #include "wavog_mapping/io/image_io.h"
+#include "wavog_mapping/io/ndt_image.h"
 #include "wavog_mapping/ros/config.h"
 #include "wavog_mapping/ros/scan_placement.h"
 
@@ -245,6 +248,75 @@ TEST_F(OfflineFr079, CarmenLogDirectlyWithPolicyAndScaleOptions) {
   }
   const MapDiff d = compare(direct, loaded);
   EXPECT_EQ(d.known_mismatch + d.value_mismatch, 0u) << d.known_mismatch << " " << d.value_mismatch;
+}
+
+TEST(OfflineNdt, PicturesAndCountsOfTheGaussiansPerScaleEqualTheCoreMaps) {
+  const std::string log = dataFile("fr079-corrected.log.gz");
+  ASSERT_FALSE(log.empty()) << "shared data not found: set WAVOG_DATA_DIR";
+  constexpr std::size_t kNdtScans = 150;
+  const fs::path out = workDir() / "fr079_ndt";
+  const RunResult r =
+      run(WAVOG_OFFLINE, "--no-progress --ndt --max-scans " + std::to_string(kNdtScans) +
+                             " --scale 0,2 -o " + out.string() + " " + log);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json json = readJson(out / "summary.json");
+  EXPECT_EQ(json["ndt"], true) << json;
+  EXPECT_FALSE(fs::exists(out / "ndt_s1.png"));
+
+  // The same scans through the core directly (the CARMEN path is exact, see above).
+  wavog::MapParams params = defaultParams();
+  params.ndt = true;
+  wavog::WaveletMap direct(params);
+  for (const wavog::CarmenScan& scan : wavog::readCarmenLog(log, kNdtScans)) {
+    direct.integrate(scan.laser_pose, scan.view(0.0));
+  }
+  EXPECT_EQ(json["map"]["ndt_cells"], direct.stats().ndt_cells) << json;
+  ASSERT_EQ(json["scales"].size(), 2u) << json;
+  const wavog::NdtRenderOptions options;
+  for (const nlohmann::json& entry : json["scales"]) {
+    const int scale = entry["scale"];
+    SCOPED_TRACE("scale " + std::to_string(scale));
+    // Over the whole map: no Gaussian lies outside the picture's cropped box.
+    wavog::CellBox box;
+    ASSERT_TRUE(direct.bounds(scale, &box));
+    const wavog::NdtLayer layer = direct.exportNdt(scale, box);
+    ASSERT_GT(layer.cells.size(), 100u);
+    const nlohmann::json& ndt = entry["ndt"];
+    EXPECT_EQ(ndt["gaussians"], layer.cells.size()) << ndt;
+    double weight = 0.0;
+    for (const wavog::NdtCell& c : layer.cells) weight += c.weight;
+    const double mean_weight = weight / static_cast<double>(layer.cells.size());
+    EXPECT_NEAR(ndt["mean_weight"].get<double>(), mean_weight, 1e-9 * mean_weight) << ndt;
+    EXPECT_GT(mean_weight, 0.0);
+
+    // The picture: the occupancy map's cells times the upscale, the largest within the budget.
+    const wavog::Image png = wavog::readPng((out / ndt["png"].get<std::string>()).string());
+    const int k = ndt["upscale"];
+    const std::int64_t w = entry["width"];
+    const std::int64_t h = entry["height"];
+    ASSERT_GE(k, 1);
+    ASSERT_LE(k, options.max_upscale);
+    EXPECT_TRUE(k == options.max_upscale ||
+                static_cast<double>(w * h) * (k + 1) * (k + 1) > options.max_pixels);
+    EXPECT_EQ(png.channels, 3);
+    EXPECT_EQ(png.width, w * k);
+    EXPECT_EQ(png.height, h * k);
+    // Every mean has its own pixel (distinct cells) in the mean colour, no map pixel has it, and
+    // the occupied walls have outlines.
+    std::size_t means = 0;
+    std::size_t outlines = 0;
+    for (int y = 0; y < png.height; ++y) {
+      for (int x = 0; x < png.width; ++x) {
+        const std::uint8_t* p = png.at(x, y);
+        means += p[0] == options.mean_colour.r && p[1] == options.mean_colour.g &&
+                 p[2] == options.mean_colour.b;
+        outlines += p[0] == options.occupied_colour.r && p[1] == options.occupied_colour.g &&
+                    p[2] == options.occupied_colour.b;
+      }
+    }
+    EXPECT_GE(means, layer.cells.size());
+    EXPECT_GT(outlines, layer.cells.size() / 2);
+  }
 }
 
 TEST(Offline, LaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) {

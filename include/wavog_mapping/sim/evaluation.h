@@ -1,8 +1,9 @@
 // Policy evaluation against the simulator's ground truth: runs a scenario's scans through the
 // core map (wavog::WaveletMap) under each update policy and measures responsiveness (how long a
 // departed car's cells stay occupied, how long an arrived car takes to appear), precision (occupied
-// cells against the true surfaces, thickness of walls), compactness (nodes, bytes per observed
-// cell) and integration time. ROS-free. Not thread-safe (one evaluation per thread).
+// cells against the true surfaces, thickness of walls, and with MapParams::ndt the NDT means
+// against the true walls), compactness (nodes, bytes per observed cell) and integration time.
+// ROS-free. Not thread-safe (one evaluation per thread).
 #ifndef WAVOG_MAPPING_SIM_EVALUATION_H_
 #define WAVOG_MAPPING_SIM_EVALUATION_H_
 
@@ -16,6 +17,7 @@
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/sim/ground_truth.h"
 #include "wavog_mapping/sim/laser_sim.h"
+#include "wavog_mapping/sim/wall_metrics.h"
 #include "wavog_mapping/sim/world.h"
 
 namespace wavog {
@@ -86,6 +88,11 @@ struct PolicyResult {
   double max_scan_us = 0.0;
   double total_s = 0.0;  ///< integration time of the whole scenario (s)
   Raster final_map;      ///< the region of interest at scale 0, at the end
+  /// With MapParams::ndt: occupied cell centres and NDT means against the true walls at the end,
+  /// at scale 0 over the region of interest (within wall_margin of a wall); else all NaN / 0.
+  NdtWallDistance ndt_walls;
+  std::size_t ndt_cells = 0;  ///< with MapParams::ndt: finest cells holding a Gaussian
+  std::size_t ndt_bytes = 0;  ///< with MapParams::ndt: of `bytes`, the Gaussians' share
 };
 
 /// Options of an evaluation.

@@ -1,6 +1,7 @@
 // Wall sharpness of an occupancy map: the width at half maximum of the occupancy profile across
 // straight walls, and where the profiles are taken (from a simulated world's true walls, or from
-// a reference map's straight occupied stretches when there is no ground truth, as on real logs).
+// a reference map's straight occupied stretches when there is no ground truth, as on real logs);
+// how far the occupied cells and their NDT means lie from the true walls.
 // Profiles read P(occ) = 1 / (1 + exp(-log-odds)), so unbounded log-odds (policy none) and
 // bounded ones are measured alike. Units: metres; widths in cells of the raster. Pure functions
 // over values; thread-safe. ROS-free.
@@ -8,6 +9,7 @@
 #define WAVOG_MAPPING_SIM_WALL_METRICS_H_
 
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "wavog_mapping/core/wavelet_map.h"
@@ -70,6 +72,31 @@ WallWidth wallWidthAtHalfMax(const Raster& map, const std::vector<WallSample>& s
 /// is ideal). `cells` (if given) receives the number of cells averaged. 0 when there are none.
 double meanDistanceToWallSurface(const World& world, double t, const Raster& map,
                                  double margin_m = 1.0, std::size_t* cells = nullptr);
+
+/// How far the map puts the walls from their true surfaces, cell centres against NDT means
+/// (paper section 1.2.3: NDT cells reduce the grid's discretisation error). Distances are exact,
+/// from a point to the nearest edge of a wall (ObjectKind::kWall present at t), inside or
+/// outside alike. NaN where nothing was averaged.
+struct NdtWallDistance {
+  /// Mean distance of the centres of the occupied cells near walls (as in
+  /// meanDistanceToWallSurface: observed, log-odds > 1e-3, within the margin of a wall and
+  /// nearer to a wall than to any other object).
+  double cell_centre_m = std::numeric_limits<double>::quiet_NaN();
+  std::size_t cells = 0;  ///< cells averaged in cell_centre_m
+  /// The same over those of the cells that hold a Gaussian (the cells of ndt_mean_m).
+  double ndt_cell_centre_m = std::numeric_limits<double>::quiet_NaN();
+  /// Mean distance of the Gaussians' means of those cells.
+  double ndt_mean_m = std::numeric_limits<double>::quiet_NaN();
+  std::size_t gaussians = 0;  ///< Gaussians averaged in ndt_mean_m
+};
+
+/// Cell centres and NDT means of `map` against the world's walls at t. `ndt` is the map's
+/// exportNdt at the raster's scale (same cell size; Gaussians outside the raster are ignored).
+NdtWallDistance ndtWallDistance(const World& world, double t, const Raster& map,
+                                const NdtLayer& ndt, double margin_m = 1.0);
+
+/// Distance (m) from `p` to the nearest edge of a wall present at t; +inf without walls.
+double distanceToWallEdges(const World& world, double t, const Vec2& p);
 
 }  // namespace sim
 }  // namespace wavog
