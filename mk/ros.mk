@@ -1,8 +1,7 @@
 # ROS layer targets (issue 3). Neither is part of `make test`.
 #   make tsan         ThreadSanitizer build in $(BUILD_TSAN); runs the core's parallel integration
 #                     test (1, 2, 4 threads), then the integration, bad-input, hostile-input, bag-end,
-#                     lost-scans and
-#                     reconfigure rostests against the node (4 scan inputs, tf, timers on 4
+#                     lost-scans, NDT-topics and reconfigure rostests against the node (4 scan inputs, tf, timers on 4
 #                     threads; the idle flush racing the tf filters; live reconfigure).
 #                     roscpp-internal reports are suppressed (test/ros/tsan.supp). ~4 min on 2 cores.
 #   make rviz-check   installs rviz + Xvfb (separate from `make deps`), plays 40 s of the simulated
@@ -21,7 +20,7 @@ tsan: deps
 	  >$(BUILD_TSAN)/configure.log || { cat $(BUILD_TSAN)/configure.log; exit 1; }
 	@bash $(ROOT)/scripts/build.sh $(BUILD_TSAN) $(JOBS) wavog_mapping_node test_mapping_system \
 	  test_bad_input test_hostile_input test_bag_end test_reconfigure_policy \
-	  test_lost_scans test_parallel_integration
+	  test_lost_scans test_ndt_topics test_parallel_integration
 	@rm -f $(BUILD_TSAN)/tsan/report.*
 	@# The core's parallel integration (worker threads, node pool) with 1, 2 and 4 threads.
 	@TSAN_OPTIONS="log_path=$(BUILD_TSAN)/tsan/report second_deadlock_stack=1" \
@@ -33,7 +32,8 @@ tsan: deps
 	  export TSAN_OPTIONS="log_path=$(BUILD_TSAN)/tsan/report second_deadlock_stack=1 history_size=4 suppressions=$(ROOT)/test/ros/tsan.supp"; \
 	  rostest wavog_mapping mapping_node.test && rostest wavog_mapping bad_input.test && \
 	  rostest wavog_mapping hostile_input.test && rostest wavog_mapping bag_end.test && \
-	  rostest wavog_mapping reconfigure_policy.test && rostest wavog_mapping lost_scans.test
+	  rostest wavog_mapping reconfigure_policy.test && rostest wavog_mapping lost_scans.test && \
+	  rostest wavog_mapping ndt_topics.test
 	@if ls $(BUILD_TSAN)/tsan/report.* >/dev/null 2>&1; then \
 	  cat $(BUILD_TSAN)/tsan/report.*; echo "tsan: ThreadSanitizer reports above"; exit 1; \
 	else echo "tsan: no data race reported"; fi
