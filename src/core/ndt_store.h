@@ -71,6 +71,12 @@ struct NdtCells {
         std::upper_bound(entries.begin() + static_cast<std::ptrdiff_t>(sorted), entries.end(), code,
                          [](std::uint32_t c, const NdtEntry& x) { return c < x.code; });
     ++dead;  // empty until its first end-point is added
+    if (entries.size() == entries.capacity()) {
+      // Grow by a quarter (not the usual double): at most 25 % of the bytes go unused.
+      const auto at = pos - entries.begin();
+      entries.reserve(entries.size() + entries.size() / 4 + kTail);
+      return *entries.insert(entries.begin() + at, NdtEntry{code, {}});
+    }
     return *entries.insert(pos, NdtEntry{code, {}});
   }
   /// Merges the tail into the first run when it is longer than 2 sqrt(sorted) and kTail.
