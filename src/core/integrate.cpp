@@ -95,7 +95,7 @@ std::uint64_t updateBlocksFor(WaveletMap::Impl& impl, detail::NodeStore& store,
                               const std::vector<detail::BlockJob>& jobs,
                               std::atomic<std::size_t>* next) {
   if constexpr (P == PolicyType::kForget) {  // the one policy whose observations change them
-    if (ndt != nullptr && ndt->a != 1.0) {
+    if (ndt != nullptr && ndt->forgets()) {
       return detail::updateBlocks<P, true>(impl, store, cls, pc, ndt, jobs, next);
     }
   }

@@ -131,6 +131,14 @@ struct WaveletMap::Impl {
   detail::Block* findBlock(std::int64_t bx, std::int64_t by);
   const detail::Block* findBlock(std::int64_t bx, std::int64_t by) const;
   detail::Block& getOrCreateBlock(std::int64_t bx, std::int64_t by);
+  /// What the map holds for the scale-s cell (x, y) of the extent: its Haar average, read from the
+  /// block root down (lazy tags applied on the way, nothing written), and the knowledge bits of the
+  /// slot it was read from (the cell itself, or a uniform slot above it).
+  struct SlotRead {
+    double average;
+    bool known_all, known_any;
+  };
+  SlotRead read(int s, std::int64_t x, std::int64_t y) const;
   /// Drops a block that holds nothing (uniform, unobserved, at the prior).
   void dropIfEmpty(std::int64_t bx, std::int64_t by);
   /// Erases block `key` (its nodes must be freed already); its spare groups go to the pool.

@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "map_impl.h"
-#include "wavog_mapping/core/haar.h"
 #include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
@@ -17,7 +16,6 @@ namespace wavog {
 using detail::Block;
 using detail::NdtEntry;
 using detail::NdtMoments;
-using detail::Node;
 
 namespace {
 
@@ -27,21 +25,8 @@ void requireNdt(const WaveletMap::Impl& impl) {
   }
 }
 
-// Moments about a common origin, accumulated from cells at offsets (ox, oy) from it.
-struct MomentSum {
-  double w = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
-  void add(const NdtMoments& m, double ox, double oy) {
-    w += m.w;
-    sx += m.sx + m.w * ox;
-    sy += m.sy + m.w * oy;
-    sxx += m.sxx + 2.0 * ox * m.sx + m.w * ox * ox;
-    sxy += m.sxy + ox * m.sy + oy * m.sx + m.w * ox * oy;
-    syy += m.syy + 2.0 * oy * m.sy + m.w * oy * oy;
-  }
-};
-
 // The Gaussian of moments `m` about the point (cx, cy) of the map frame.
-NdtCell gaussian(const MomentSum& m, double cx, double cy) {
+NdtCell gaussian(const NdtMoments& m, double cx, double cy) {
   NdtCell c;
   c.weight = m.w;
   const double mx = m.sx / m.w, my = m.sy / m.w;
@@ -53,28 +38,19 @@ NdtCell gaussian(const MomentSum& m, double cx, double cy) {
   return c;
 }
 
-// The Haar average of the scale-s cell (x, y) (lazy tags applied on the way, nothing written).
-double averageAt(const WaveletMap::Impl& impl, int s, std::int64_t x, std::int64_t y) {
-  const int L = impl.levels;
-  const std::int64_t fx = detail::scaleUp(x, s), fy = detail::scaleUp(y, s);
-  const Block* b = impl.findBlock(detail::floorShift(fx, L), detail::floorShift(fy, L));
-  if (b == nullptr) return impl.init;
-  double avg = b->s;
-  if (!b->has_root) return b->known_any ? avg : impl.init;
-  const Node* n = &b->root;
-  double mult = 1.0;
-  for (int l = L; l > s; --l) {
-    mult *= impl.multiplier(n->k);
-    const int q = static_cast<int>(((fx >> (l - 1)) & 1) | (((fy >> (l - 1)) & 1) << 1));
-    const double d[3] = {n->d[0] * mult, n->d[1] * mult, n->d[2] * mult};
-    avg = haar::backwardChild(avg, d, q);
-    if (l - 1 == s || l == 1 || !impl.hasChild(*n, q)) return avg;
-    n = &impl.child(*n, q);
-  }
-  return avg;
-}
-
 }  // namespace
+
+NdtAxes principalAxes(double cov_xx, double cov_xy, double cov_yy) {
+  // Eigenvalues of a symmetric 2x2: mean +- radius; the major axis at half the angle of
+  // (xx - yy, 2 xy).
+  const double mean = 0.5 * (cov_xx + cov_yy);
+  const double radius = std::hypot(0.5 * (cov_xx - cov_yy), cov_xy);
+  NdtAxes axes;
+  axes.sigma_major = std::sqrt(std::max(0.0, mean + radius));
+  axes.sigma_minor = std::sqrt(std::max(0.0, mean - radius));
+  axes.yaw = 0.5 * std::atan2(2.0 * cov_xy, cov_xx - cov_yy);
+  return axes;
+}
 
 NdtLayer WaveletMap::exportNdt(int scale, const CellBox& window) const {
   const Impl& impl = *impl_;
@@ -130,16 +106,16 @@ NdtLayer WaveletMap::exportNdt(int scale, const CellBox& window) const {
     // Moments about the scale-s cell's centre.
     const double ccx = (static_cast<double>(cx) + 0.5) * big;
     const double ccy = (static_cast<double>(cy) + 0.5) * big;
-    MomentSum sum;
+    NdtMoments sum;
     for (; i < items.size() && items[i].cx == cx && items[i].cy == cy; ++i) {
       const double ox = (static_cast<double>(items[i].ix) + 0.5) * r - ccx;
       const double oy = (static_cast<double>(items[i].iy) + 0.5) * r - ccy;
-      sum.add(*items[i].m, ox, oy);
+      sum.addShifted(*items[i].m, ox, oy);
     }
     NdtCell c = gaussian(sum, ccx, ccy);
     c.ix = cx;
     c.iy = cy;
-    c.log_odds = static_cast<float>(averageAt(impl, scale, cx, cy));
+    c.log_odds = static_cast<float>(impl.read(scale, cx, cy).average);
     out.cells.push_back(c);
   }
   return out;
@@ -157,9 +133,7 @@ bool WaveletMap::ndtCell(const CellIndex& cell, NdtCell* out) const {
                                                       static_cast<std::uint32_t>(cell.y & mask)));
   if (e == nullptr || !detail::NdtCells::live(*e)) return false;
   const double r = impl.params.grid.resolution;
-  MomentSum sum;
-  sum.add(e->m, 0.0, 0.0);
-  *out = gaussian(sum, (static_cast<double>(cell.x) + 0.5) * r,
+  *out = gaussian(e->m, (static_cast<double>(cell.x) + 0.5) * r,
                   (static_cast<double>(cell.y) + 0.5) * r);
   out->ix = cell.x;
   out->iy = cell.y;

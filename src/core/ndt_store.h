@@ -29,6 +29,16 @@ struct NdtMoments {
     sxy *= f;
     syy *= f;
   }
+  /// Adds the moments `m` of a cell whose centre lies at (ox, oy) from this one's origin (the
+  /// parallel-axis shift).
+  void addShifted(const NdtMoments& m, double ox, double oy) {
+    w += m.w;
+    sx += m.sx + m.w * ox;
+    sy += m.sy + m.w * oy;
+    sxx += m.sxx + 2.0 * ox * m.sx + m.w * ox * ox;
+    sxy += m.sxy + ox * m.sy + oy * m.sx + m.w * ox * oy;
+    syy += m.syy + 2.0 * oy * m.sy + m.w * oy * oy;
+  }
   void add(double g, double x, double y) {
     w += g;
     sx += g * x;

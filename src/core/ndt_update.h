@@ -54,7 +54,6 @@ class NdtScanPoints {
       return a.beam < b.beam;
     });
   }
-  bool empty() const { return points_.empty(); }
   /// The points of block `key`: [*first, *last).
   void inBlock(std::uint64_t key, const NdtPoint** first, const NdtPoint** last) const {
     const auto lo =
@@ -77,10 +76,11 @@ struct NdtSpan {
   bool empty() const { return b1 == e1 && b2 == e2; }
   /// The entries under child q of the level-l square (their codes' bits 2(l-1), 2(l-1)+1 are q).
   void split(int l, NdtSpan out[4]) const {
-    splitRun(b1, e1, l, &out[0].b1, &out[0].e1, &out[1].b1, &out[1].e1, &out[2].b1, &out[2].e1,
-             &out[3].b1, &out[3].e1);
-    splitRun(b2, e2, l, &out[0].b2, &out[0].e2, &out[1].b2, &out[1].e2, &out[2].b2, &out[2].e2,
-             &out[3].b2, &out[3].e2);
+    NdtEntry* cuts1[5];
+    NdtEntry* cuts2[5];
+    cutRun(b1, e1, l, cuts1);
+    cutRun(b2, e2, l, cuts2);
+    for (int q = 0; q < 4; ++q) out[q] = {cuts1[q], cuts1[q + 1], cuts2[q], cuts2[q + 1]};
   }
   template <typename F>
   void forEach(F f) const {
@@ -89,20 +89,15 @@ struct NdtSpan {
   }
 
  private:
-  static void splitRun(NdtEntry* b, NdtEntry* e, int l, NdtEntry** b0, NdtEntry** e0, NdtEntry** b1,
-                       NdtEntry** e1, NdtEntry** b2, NdtEntry** e2, NdtEntry** b3, NdtEntry** e3) {
+  // The sorted run [b, e) cut by quadrant: child q's entries are [cuts[q], cuts[q + 1]).
+  static void cutRun(NdtEntry* b, NdtEntry* e, int l, NdtEntry* cuts[5]) {
     const int shift = 2 * (l - 1);
-    const auto upto = [shift](unsigned q) {
-      return [shift, q](const NdtEntry& x) { return ((x.code >> shift) & 3u) <= q; };
-    };
-    NdtEntry* m0 = b == e ? e : std::partition_point(b, e, upto(0));
-    NdtEntry* m1 = m0 == e ? e : std::partition_point(m0, e, upto(1));
-    NdtEntry* m2 = m1 == e ? e : std::partition_point(m1, e, upto(2));
-    *b0 = b;
-    *e0 = *b1 = m0;
-    *e1 = *b2 = m1;
-    *e2 = *b3 = m2;
-    *e3 = e;
+    cuts[0] = b;
+    for (unsigned q = 0; q < 3; ++q) {
+      cuts[q + 1] = std::partition_point(
+          cuts[q], e, [shift, q](const NdtEntry& x) { return ((x.code >> shift) & 3u) <= q; });
+    }
+    cuts[4] = e;
   }
 };
 
@@ -113,19 +108,19 @@ struct NdtConsts {
   double g = 1.0;
   double cap = std::numeric_limits<double>::infinity();
   double min_weight = 0.0;
+
+  /// True when an observation changes a Gaussian (the walk has to find the observed ones).
+  bool forgets() const { return a != 1.0; }
 };
 
 /// The update of one block's Gaussians by a scan, in three steps: begin() makes the cells of the
 /// scan's end-points (empty) and gives the span of all entries; the quadtree walk
 /// (Integrator<P, true>, quadtree_update.h) calls forget() on every entry whose cell the scan
-/// observes ("forget" only: forgets() is false otherwise); finish() adds the end-points, caps the
+/// observes (only when NdtConsts::forgets()); finish() adds the end-points, caps the
 /// weights and drops what is under the threshold.
 class NdtBlockUpdate {
  public:
   NdtBlockUpdate(const ScanClassifier& cls, const NdtConsts& c) : cls_(cls), c_(c) {}
-
-  /// True when an observation changes a Gaussian (the walk has to find the observed ones).
-  bool forgets() const { return c_.a != 1.0; }
 
   /// Starts block (origin cell ix0, iy0) with its end-points [first, last); returns the span of
   /// its entries.

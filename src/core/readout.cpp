@@ -98,10 +98,13 @@ class RasterWriter {
 
 }  // namespace
 
+double probabilityFromLogOdds(float log_odds) {
+  return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
+}
+
 std::int8_t occupancyFromLogOdds(float log_odds) {
   if (std::isnan(log_odds)) return -1;
-  const double p = 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
-  return static_cast<std::int8_t>(std::lround(100.0 * p));
+  return static_cast<std::int8_t>(std::lround(100.0 * probabilityFromLogOdds(log_odds)));
 }
 
 std::vector<std::int8_t> toOccupancyGrid(const Raster& raster) {

@@ -38,34 +38,35 @@ CellIndex WaveletMap::cellAt(double x, double y) const {
   return {clampedCellIndex(std::floor(x / r)), clampedCellIndex(std::floor(y / r))};
 }
 
-namespace {
-// Walks from the block root towards `cell`, reconstructing averages (lazy tags applied on the
-// way, nothing written). Returns the cell's value and whether it was observed.
-std::pair<float, bool> lookup(const WaveletMap::Impl& impl, const CellIndex& cell) {
-  const int levels = impl.levels;
-  // Outside the extent no block exists; a 32-bit block key of such a cell would alias one.
-  if (!inExtent(cell.x, cell.y)) return {static_cast<float>(impl.init), false};
-  const Block* b =
-      impl.findBlock(detail::floorShift(cell.x, levels), detail::floorShift(cell.y, levels));
-  if (b == nullptr) return {static_cast<float>(impl.init), false};
-  double s = b->s;
-  if (!b->has_root) return {static_cast<float>(b->known_all ? s : impl.init), b->known_all};
+WaveletMap::Impl::SlotRead WaveletMap::Impl::read(int s, std::int64_t x, std::int64_t y) const {
+  const std::int64_t fx = detail::scaleUp(x, s), fy = detail::scaleUp(y, s);
+  const Block* b = findBlock(detail::floorShift(fx, levels), detail::floorShift(fy, levels));
+  if (b == nullptr) return {init, false, false};
+  double avg = b->s;
+  if (!b->has_root) return {avg, b->known_all, b->known_any};
   const Node* n = &b->root;
   double mult = 1.0;
-  for (int l = levels; l >= 1; --l) {
-    mult *= impl.multiplier(n->k);
-    const int q = static_cast<int>(((cell.x >> (l - 1)) & 1) | (((cell.y >> (l - 1)) & 1) << 1));
+  for (int l = levels; l > s; --l) {
+    mult *= multiplier(n->k);
+    const int q = static_cast<int>(((fx >> (l - 1)) & 1) | (((fy >> (l - 1)) & 1) << 1));
     const double d[3] = {n->d[0] * mult, n->d[1] * mult, n->d[2] * mult};
-    s = haar::backwardChild(s, d, q);
-    if (l == 1 || !impl.hasChild(*n, q)) {
-      // A never-observed cell holds the prior exactly; reading it back through the details
-      // would only add their float round-off.
-      const bool known = ((n->known_all >> q) & 1u) != 0;
-      return {static_cast<float>(known ? s : impl.init), known};
+    avg = haar::backwardChild(avg, d, q);
+    if (l - 1 == s || !hasChild(*n, q)) {
+      return {avg, ((n->known_all >> q) & 1u) != 0, ((n->known_any >> q) & 1u) != 0};
     }
-    n = &impl.child(*n, q);
+    n = &child(*n, q);
   }
-  return {static_cast<float>(s), false};
+  return {avg, b->known_all, b->known_any};  // s = levels: the block itself
+}
+
+namespace {
+// The value of one finest cell and whether it was observed. A never-observed cell holds the prior
+// exactly; reading it back through the details would only add their float round-off.
+std::pair<float, bool> lookup(const WaveletMap::Impl& impl, const CellIndex& cell) {
+  // Outside the extent no block exists; a 32-bit block key of such a cell would alias one.
+  if (!inExtent(cell.x, cell.y)) return {static_cast<float>(impl.init), false};
+  const WaveletMap::Impl::SlotRead r = impl.read(0, cell.x, cell.y);
+  return {static_cast<float>(r.known_all ? r.average : impl.init), r.known_all};
 }
 }  // namespace
 

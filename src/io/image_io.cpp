@@ -65,7 +65,7 @@ std::string formatDouble(double v) {
 
 std::uint8_t greyFromLogOdds(float log_odds) {
   if (std::isnan(log_odds)) return 127;
-  const double p = 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
+  const double p = probabilityFromLogOdds(log_odds);
   return static_cast<std::uint8_t>(std::lround(254.0 * (1.0 - p)));
 }
 

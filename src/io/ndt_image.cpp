@@ -54,18 +54,13 @@ void drawEllipseOutline(Image* image, const PixelFrame& frame, double mean_x, do
       !(frame.metres_per_pixel > 0.0)) {
     return;
   }
-  // Eigen-decomposition of the symmetric 2x2 covariance; rounding may leave a tiny negative
-  // eigenvalue, which is a line (0).
-  const double half_trace = 0.5 * (cov_xx + cov_yy);
-  const double spread = std::hypot(0.5 * (cov_xx - cov_yy), cov_xy);
-  const double major = std::max(0.0, half_trace + spread);
-  const double minor = std::max(0.0, half_trace - spread);
-  const double angle = 0.5 * std::atan2(2.0 * cov_xy, cov_xx - cov_yy);  // of the major axis
-  // Semi-axes in pixels, and the major axis as a unit vector in the map frame.
-  const double a = std::fabs(sigmas) * std::sqrt(major) / frame.metres_per_pixel;
-  const double b = std::fabs(sigmas) * std::sqrt(minor) / frame.metres_per_pixel;
-  const double ex = std::cos(angle);
-  const double ey = std::sin(angle);
+  // Semi-axes in pixels, and the major axis as a unit vector in the map frame (a degenerate
+  // covariance gives a line or a point).
+  const NdtAxes axes = principalAxes(cov_xx, cov_xy, cov_yy);
+  const double a = std::fabs(sigmas) * axes.sigma_major / frame.metres_per_pixel;
+  const double b = std::fabs(sigmas) * axes.sigma_minor / frame.metres_per_pixel;
+  const double ex = std::cos(axes.yaw);
+  const double ey = std::sin(axes.yaw);
   const double u0 = columnOf(frame, mean_x);
   const double r0 = rowOf(*image, frame, mean_y);
   // Arc length between samples <= a * dt (a >= b); the map's y is the picture's -r.

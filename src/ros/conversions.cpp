@@ -27,13 +27,11 @@ bool clip(double clip_lo, double clip_hi, double* lo, double* hi) {
 
 }  // namespace
 
-
 const char* toString(DropReason reason) {
   // In DropReason order.
   static constexpr const char* kNames[kNumDropReasons] = {
-      "empty",          "size_mismatch", "bad_angles",    "bad_frame",
-      "tf_unavailable", "tf_too_old",    "no_valid_beam", "bad_geometry",
-      "bad_time",       "exception"};
+      "empty",      "size_mismatch", "bad_angles",   "bad_frame", "tf_unavailable",
+      "tf_too_old", "no_valid_beam", "bad_geometry", "bad_time",  "exception"};
   const auto i = static_cast<std::size_t>(reason);
   return i < kNumDropReasons ? kNames[i] : "unknown";
 }
@@ -152,10 +150,13 @@ LayerSize layerBox(const wavog::WaveletMap& map, int scale, double window, doubl
   if (!map.bounds(scale, &b) || b.empty()) return LayerSize::kEmpty;
   if (window > 0.0) {
     const double cell = std::ldexp(map.resolution(), scale);
-    const double bx0 = static_cast<double>(b.min_x) * cell, bx1 = static_cast<double>(b.max_x) * cell;
-    const double by0 = static_cast<double>(b.min_y) * cell, by1 = static_cast<double>(b.max_y) * cell;
+    const double bx0 = static_cast<double>(b.min_x) * cell,
+                 bx1 = static_cast<double>(b.max_x) * cell;
+    const double by0 = static_cast<double>(b.min_y) * cell,
+                 by1 = static_cast<double>(b.max_y) * cell;
     double x0 = cx - window, x1 = cx + window, y0 = cy - window, y1 = cy + window;
-    if (!clip(bx0 - window, bx1 + window, &x0, &x1) || !clip(by0 - window, by1 + window, &y0, &y1)) {
+    if (!clip(bx0 - window, bx1 + window, &x0, &x1) ||
+        !clip(by0 - window, by1 + window, &y0, &y1)) {
       return LayerSize::kEmpty;
     }
     if ((x1 - x0) / cell * ((y1 - y0) / cell) > kMaxLayerCells &&
@@ -199,21 +200,12 @@ nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::ReflectionRaster& r
   return gridMsg(raster, frame, stamp);
 }
 
-namespace {
-double occupancyProbability(float log_odds) {
-  return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
-}
-}  // namespace
-
 void ndtEllipse(double cov_xx, double cov_xy, double cov_yy, double* major, double* minor,
                 double* yaw) {
-  // Eigenvalues of a symmetric 2x2: mean +- radius; the major axis at half the angle of
-  // (xx - yy, 2 xy). Rounding may leave a tiny negative eigenvalue: taken as 0.
-  const double mean = 0.5 * (cov_xx + cov_yy);
-  const double radius = std::hypot(0.5 * (cov_xx - cov_yy), cov_xy);
-  *major = 4.0 * std::sqrt(std::max(0.0, mean + radius));
-  *minor = 4.0 * std::sqrt(std::max(0.0, mean - radius));
-  *yaw = 0.5 * std::atan2(2.0 * cov_xy, cov_xx - cov_yy);
+  const wavog::NdtAxes axes = wavog::principalAxes(cov_xx, cov_xy, cov_yy);
+  *major = 4.0 * axes.sigma_major;  // 2-sigma diameters
+  *minor = 4.0 * axes.sigma_minor;
+  *yaw = axes.yaw;
 }
 
 visualization_msgs::MarkerArray::Ptr toNdtMarkers(const wavog::NdtLayer& layer,
@@ -246,7 +238,7 @@ visualization_msgs::MarkerArray::Ptr toNdtMarkers(const wavog::NdtLayer& layer,
     m.scale.x = std::max(major, min_axis);
     m.scale.y = std::max(minor, min_axis);
     m.scale.z = kNdtMarkerThickness;
-    const double p = occupancyProbability(c.log_odds);
+    const double p = wavog::probabilityFromLogOdds(c.log_odds);
     m.color.r = static_cast<float>(p);
     m.color.g = 0.0f;
     m.color.b = static_cast<float>(1.0 - p);
@@ -277,8 +269,9 @@ sensor_msgs::PointCloud2::Ptr toNdtCloud(const wavog::NdtLayer& layer, const std
   std::vector<sensor_msgs::PointCloud2Iterator<float>> it;
   for (const char* f : kNames) it.emplace_back(*msg, f);
   for (const wavog::NdtCell& c : layer.cells) {
-    const double values[kFields] = {c.mean_x, c.mean_y, 0.0,      c.cov_xx,
-                                    c.cov_xy, c.cov_yy, c.weight, occupancyProbability(c.log_odds)};
+    const double values[kFields] = {
+        c.mean_x, c.mean_y, 0.0,      c.cov_xx,
+        c.cov_xy, c.cov_yy, c.weight, wavog::probabilityFromLogOdds(c.log_odds)};
     for (std::size_t f = 0; f < kFields; ++f) {
       *it[f] = static_cast<float>(values[f]);
       ++it[f];

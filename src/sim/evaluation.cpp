@@ -26,10 +26,6 @@ bool seenFree(const SimScan& scan, const LaserParams& l, const CellIndex& cell, 
   return scan.true_ranges[static_cast<std::size_t>(beam)] > std::hypot(cx, cy) + res;
 }
 
-double probability(float log_odds) {
-  return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
-}
-
 // Time at which a departing object starts to move: the end of its first constant stretch.
 double departureStart(const WorldObject& o) {
   const std::vector<Waypoint>& w = o.trajectory.waypoints;
@@ -189,7 +185,7 @@ PolicyResult evaluatePolicy(const World& world, const std::vector<SimScan>& scan
   };
   auto mean_occupancy = [&map](const WorldEvent& e) {
     double sum = 0.0;
-    for (const CellIndex& c : e.cells) sum += probability(map.value(c));
+    for (const CellIndex& c : e.cells) sum += probabilityFromLogOdds(map.value(c));
     return e.cells.empty() ? 0.0 : sum / static_cast<double>(e.cells.size());
   };
 

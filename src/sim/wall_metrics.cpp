@@ -15,10 +15,6 @@ namespace {
 
 constexpr double kFreeStep = 0.05;  // m between the free-side points checked against objects
 
-double probability(float log_odds) {
-  return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
-}
-
 // Raster index of a world point, or -1 outside.
 long long indexAt(const Raster& r, const Vec2& p) {
   const auto ix = static_cast<std::int64_t>(std::floor(p.x() / r.cell_size)) - r.box.min_x;
@@ -184,7 +180,7 @@ WallWidth wallWidthAtHalfMax(const Raster& map, const std::vector<WallSample>& s
       const long long i = indexAt(map, s.point + (k * step) * s.normal);
       if (i >= 0 && map.known[static_cast<std::size_t>(i)]) {
         profile[static_cast<std::size_t>(k - lo)] =
-            probability(map.log_odds[static_cast<std::size_t>(i)]);
+            probabilityFromLogOdds(map.log_odds[static_cast<std::size_t>(i)]);
       }
     }
     // Peak near the surface, base on the free side (either side when two-sided).

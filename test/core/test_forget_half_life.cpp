@@ -163,18 +163,6 @@ TEST(ForgetHalfLife, LasersAt10And40HzForgetACellAtTheSameRatePerSecond) {
             0.2 * range);
 }
 
-// Cell-by-cell equality of two maps over a box (values and knowledge).
-void expectSameCells(const WaveletMap& a, const WaveletMap& b, int half, double tolerance) {
-  for (std::int64_t iy = -half; iy < half; ++iy) {
-    for (std::int64_t ix = -half; ix < half; ++ix) {
-      const wavog::CellIndex c{ix, iy};
-      ASSERT_EQ(a.isObserved(c), b.isObserved(c)) << ix << ", " << iy;
-      ASSERT_NEAR(a.value(c), b.value(c), tolerance * std::max(1.0, std::fabs(double{b.value(c)})))
-          << ix << ", " << iy;
-    }
-  }
-}
-
 TEST(ForgetHalfLife, FilesKeepThePendingUnits) {
   const std::string path = ::testing::TempDir() + "half_life_" + std::to_string(::getpid());
   WaveletMap map(halfLifeParams(0.3));
@@ -205,10 +193,7 @@ TEST(ForgetHalfLife, FilesOfFormatVersion1StillLoad) {
   p.grid.block_levels = 6;
   WaveletMap made(p);
   RandomScans scans(20261201u, 6.0);
-  for (int i = 0; i < 30; ++i) {
-    const OwnedScan s = scans.next();
-    made.integrate(s.pose, s.view());
-  }
+  integrateScans(&scans, 30, made);
   WaveletMap loaded(p);
   loaded.load(std::string(WAVOG_SOURCE_DIR) + "/test/core/data/forget_v1.wavog");
   // Fixed-gamma maps are what they were before forget_half_life, bit for bit.

@@ -87,11 +87,6 @@ void expectSameNdt(const WaveletMap& map, const DenseReference& ref, int max_sca
   }
 }
 
-std::vector<PolicyType> everyPolicyType() {
-  return {PolicyType::kNone,   PolicyType::kMax,        PolicyType::kClamp,
-          PolicyType::kForget, PolicyType::kClampLower, PolicyType::kClampUpper};
-}
-
 TEST(Ndt, RandomScansEveryPolicyAndPriorEveryScale) {
   const double res = 0.1, half = 12.0;
   const auto cells = static_cast<std::int64_t>(std::ceil(half / res));
@@ -106,11 +101,7 @@ TEST(Ndt, RandomScansEveryPolicyAndPriorEveryScale) {
         WaveletMap map(p);
         DenseReference ref(p, CellBox{-cells, -cells, cells, cells});
         RandomScans scans(4242u + static_cast<unsigned>(levels), half);
-        for (int i = 0; i < 200; ++i) {
-          const OwnedScan s = scans.next();
-          map.integrate(s.pose, s.view());
-          ref.integrate(s.pose, s.view());
-        }
+        integrateScans(&scans, 200, map, ref);
         expectSameNdt(map, ref, levels, name);
         EXPECT_EQ(map.stats().ndt_cells, ref.ndtCells());
       }
@@ -172,11 +163,7 @@ TEST(Ndt, ExactUnderPruningSkipsAndEagerForgetting) {
     WaveletMap map(p);
     DenseReference ref(p, CellBox{-120, -120, 120, 120});
     RandomScans scans(7u + static_cast<unsigned>(variant), 12.0);
-    for (int i = 0; i < 200; ++i) {
-      const OwnedScan s = scans.next();
-      map.integrate(s.pose, s.view());
-      ref.integrate(s.pose, s.view());
-    }
+    integrateScans(&scans, 200, map, ref);
     expectSameNdt(map, ref, 5, variant == 0 ? "pruned, skipping" : "eager");
   }
 }
@@ -237,17 +224,8 @@ TEST(Ndt, OffByDefaultAndOccupancyUnchangedWhenOn) {
   with.ndt = true;
   WaveletMap on(with);
   RandomScans scans(5u, 6.0);
-  for (int i = 0; i < 60; ++i) {
-    const OwnedScan s = scans.next();
-    off.integrate(s.pose, s.view());
-    on.integrate(s.pose, s.view());
-  }
-  for (std::int64_t y = -60; y < 60; ++y) {
-    for (std::int64_t x = -60; x < 60; ++x) {
-      ASSERT_EQ(off.value({x, y}), on.value({x, y}));
-      ASSERT_EQ(off.isObserved({x, y}), on.isObserved({x, y}));
-    }
-  }
+  integrateScans(&scans, 60, off, on);
+  expectSameCells(off, on, 60, 0.0);
   EXPECT_EQ(off.stats().ndt_bytes, 0u);
   EXPECT_GT(on.stats().ndt_bytes, 0u);
   EXPECT_EQ(on.stats().bytes - on.stats().ndt_bytes, off.stats().bytes);
@@ -271,19 +249,12 @@ TEST(Ndt, FilesAndClearing) {
   const MapParams p = ndtParams(PolicyType::kForget, 0.1, 5);
   WaveletMap map(p);
   RandomScans scans(77u, 6.0);
-  for (int i = 0; i < 80; ++i) {
-    const OwnedScan s = scans.next();
-    map.integrate(s.pose, s.view());
-  }
+  integrateScans(&scans, 80, map);
   const CellBox box{-60, -60, 60, 60};
   map.save(path);
   WaveletMap loaded(p);
   loaded.load(path);
-  for (int i = 0; i < 20; ++i) {
-    const OwnedScan s = scans.next();
-    map.integrate(s.pose, s.view());
-    loaded.integrate(s.pose, s.view());
-  }
+  integrateScans(&scans, 20, map, loaded);
   const auto a = map.exportNdt(0, box), b = loaded.exportNdt(0, box);
   ASSERT_EQ(a.cells.size(), b.cells.size());
   ASSERT_GT(a.cells.size(), 0u);
@@ -323,10 +294,7 @@ TEST(Ndt, FilesOfFormatVersion2StillLoad) {
   p.reflection = true;
   WaveletMap made(p);
   RandomScans scans(20261202u, 6.0);
-  for (int i = 0; i < 30; ++i) {
-    const OwnedScan s = scans.next();
-    made.integrate(s.pose, s.view());
-  }
+  integrateScans(&scans, 30, made);
   p.ndt = true;
   WaveletMap loaded(p);
   loaded.load(std::string(WAVOG_SOURCE_DIR) + "/test/core/data/reflection_v2.wavog");

@@ -106,11 +106,6 @@ struct ReflectionRun {
   }
 };
 
-std::vector<PolicyType> everyPolicyType() {
-  return {PolicyType::kNone,   PolicyType::kMax,        PolicyType::kClamp,
-          PolicyType::kForget, PolicyType::kClampLower, PolicyType::kClampUpper};
-}
-
 TEST(Reflection, RandomScansEveryPolicyEveryScale) {
   const double res = 0.1, half = 12.0;
   const auto cells = static_cast<std::int64_t>(std::ceil(half / res));
@@ -150,18 +145,9 @@ TEST(Reflection, OffByDefaultAndOccupancyUnchangedWhenOn) {
   with.reflection = true;
   WaveletMap on(with);
   RandomScans scans(5u, 6.0);
-  for (int i = 0; i < 60; ++i) {
-    const OwnedScan s = scans.next();
-    off.integrate(s.pose, s.view());
-    on.integrate(s.pose, s.view());
-  }
+  integrateScans(&scans, 60, off, on);
   // The occupancy is the same bit for bit; only the layers' bytes are added.
-  for (std::int64_t y = -60; y < 60; ++y) {
-    for (std::int64_t x = -60; x < 60; ++x) {
-      ASSERT_EQ(off.value({x, y}), on.value({x, y}));
-      ASSERT_EQ(off.isObserved({x, y}), on.isObserved({x, y}));
-    }
-  }
+  expectSameCells(off, on, 60, 0.0);
   EXPECT_EQ(off.stats().reflection_bytes, 0u);
   EXPECT_GT(on.stats().reflection_bytes, 0u);
   EXPECT_EQ(on.stats().bytes - on.stats().reflection_bytes, off.stats().bytes);
@@ -178,10 +164,7 @@ TEST(Reflection, FilesClearingResetAndPolicyChanges) {
   const MapParams p = reflectionParams(PolicyType::kForget, 0.1, 5);
   WaveletMap map(p);
   RandomScans scans(77u, 6.0);
-  for (int i = 0; i < 80; ++i) {
-    const OwnedScan s = scans.next();
-    map.integrate(s.pose, s.view());
-  }
+  integrateScans(&scans, 80, map);
   const CellBox box{-60, -60, 60, 60};
   const auto before = map.exportReflection(0, box);
   map.save(path);
@@ -230,10 +213,7 @@ TEST(Reflection, LongEmptyRunsCollapseTheLayersWithForgetting) {
   p.sensor.no_return_clear = 12.0;  // the empty scans below clear without hits
   WaveletMap map(p);
   RandomScans scans(3u, 6.0);
-  for (int i = 0; i < 60; ++i) {
-    const OwnedScan s = scans.next();
-    map.integrate(s.pose, s.view());
-  }
+  integrateScans(&scans, 60, map);
   const auto occupancyBytes = [&] { return map.stats().bytes - map.stats().reflection_bytes; };
   const double layers_before = static_cast<double>(map.stats().reflection_bytes);
   const double main_before = static_cast<double>(occupancyBytes());

@@ -38,6 +38,23 @@ std::vector<NamedParams> everyPolicy(double resolution, int block_levels) {
   return out;
 }
 
+std::vector<PolicyType> everyPolicyType() {
+  return {PolicyType::kNone,   PolicyType::kMax,        PolicyType::kClamp,
+          PolicyType::kForget, PolicyType::kClampLower, PolicyType::kClampUpper};
+}
+
+void expectSameCells(const wavog::WaveletMap& a, const wavog::WaveletMap& b, int half,
+                     double tolerance) {
+  for (std::int64_t iy = -half; iy < half; ++iy) {
+    for (std::int64_t ix = -half; ix < half; ++ix) {
+      const wavog::CellIndex c{ix, iy};
+      ASSERT_EQ(a.isObserved(c), b.isObserved(c)) << ix << ", " << iy;
+      ASSERT_NEAR(a.value(c), b.value(c), tolerance * std::max(1.0, std::fabs(double{b.value(c)})))
+          << ix << ", " << iy;
+    }
+  }
+}
+
 wavog::ScanView OwnedScan::view() const {
   return wavog::ScanView{ranges.data(),   ranges.size(), angle_min,
                          angle_increment, range_min,     range_max};

@@ -20,6 +20,8 @@ struct NamedParams {
   wavog::MapParams params;
 };
 std::vector<NamedParams> everyPolicy(double resolution, int block_levels);
+/// The six policies, in PolicyType's order.
+std::vector<wavog::PolicyType> everyPolicyType();
 
 /// A scan with its own storage.
 struct OwnedScan {
@@ -41,6 +43,20 @@ class RandomScans {
   std::mt19937 rng_;
   double half_;
 };
+
+/// The next `n` scans of `scans` into each of `mappers` (maps or references), scan by scan.
+template <typename... Mappers>
+void integrateScans(RandomScans* scans, int n, Mappers&... mappers) {
+  for (int i = 0; i < n; ++i) {
+    const OwnedScan s = scans->next();
+    (mappers.integrate(s.pose, s.view()), ...);
+  }
+}
+
+/// Every finest cell of [-half, half)^2: the same observed flag in `a` and `b`, and values within
+/// `tolerance` * max(1, |b|) (0: equal).
+void expectSameCells(const wavog::WaveletMap& a, const wavog::WaveletMap& b, int half,
+                     double tolerance);
 
 /// Largest |tree - reference| / max(1, |reference|) over the reference's extent, and the number
 /// of cells whose observed flag differs.

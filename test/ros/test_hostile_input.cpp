@@ -2,12 +2,12 @@
 // stay up, count the case under its reason, and map the good scan. Cases: time_increment 1e7,
 // 1e30 and NaN, a stamp of {2^32 - 1 s, 999999999 ns}, a stamp far in the future (the next good
 // scan is 2^31 s back), a /tf transform stamped 2^32 - 1 s (the tf buffer's pruning would throw:
-// refused, counted in tf_refused), lasers placed by tf 2e5 m apart (a read-out of 1.6e13 cells: the layers
-// are refused, not allocated), save_map outside map_dir ('..', absolute, through a symlink), and
-// a map_file that is /dev/zero, a FIFO or a directory (start-up fails at once, naming it); beyond
-// the core's limits: beams of 1e7 m and FLT_MAX with range_max inf, a laser 5e10 m away, a scan of
-// 1e6 beams, clear_region of +-1e19 m.
-// No exception may have been needed to survive: ~status.exceptions stays 0.
+// refused, counted in tf_refused), lasers placed by tf 2e5 m apart (a read-out of 1.6e13 cells: the
+// layers are refused, not allocated), save_map outside map_dir ('..', absolute, through a symlink),
+// and a map_file that is /dev/zero, a FIFO or a directory (start-up fails at once, naming it);
+// beyond the core's limits: beams of 1e7 m and FLT_MAX with range_max inf, a laser 5e10 m away, a
+// scan of 1e6 beams, clear_region of +-1e19 m. No exception may have been needed to survive:
+// ~status.exceptions stays 0.
 #include <gtest/gtest.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
@@ -23,8 +23,9 @@
 #include <string>
 
 #include "room.h"
-#include "wavog_mapping/MapperStatus.h"
+#include "run_command.h"
 #include "wavog_mapping/ClearRegion.h"
+#include "wavog_mapping/MapperStatus.h"
 #include "wavog_mapping/SaveMap.h"
 
 namespace {
@@ -141,7 +142,8 @@ TEST_F(Hostile, TransformStampedAtTheEndOfTimeRefused) {
   ros::WallDuration(0.2).sleep();
   const auto after = goodScanIntegrated(before->inputs[0].integrated);
   ASSERT_TRUE(after);
-  const auto s = waitStatus([&](const MapperStatus& st) { return st.tf_refused > before->tf_refused; });
+  const auto s =
+      waitStatus([&](const MapperStatus& st) { return st.tf_refused > before->tf_refused; });
   ASSERT_TRUE(s);
   EXPECT_EQ(s->tf_refused, before->tf_refused + 1);
   EXPECT_EQ(s->exceptions, 0u);
@@ -201,7 +203,7 @@ void sendNoReturnCase(const std::string& name, const sensor_msgs::LaserScan::Ptr
       waitStatus([&](const MapperStatus& s) { return s.inputs[0].integrated >= integrated; });
   ASSERT_TRUE(after);
   EXPECT_GE(after->inputs[0].integrated, integrated) << name << " and the good scan after it:\n"
-                                                    << after->inputs[0];
+                                                     << after->inputs[0];
   EXPECT_GT(after->inputs[0].beams_no_return, no_return) << name << ": a no-return, not a hit";
   EXPECT_EQ(after->exceptions, 0u);
 }
@@ -240,8 +242,8 @@ TEST_F(Hostile, BeyondTheCoreLimitsCountedAndBounded) {
   EXPECT_TRUE(clear.response.success) << clear.response.message;
   const ros::Time cleared = ros::Time::now();
   const auto empty = room::waitLatest(
-      &g_mutex, &g_map,
-      [&](const nav_msgs::OccupancyGrid& g) { return g.header.stamp > cleared; }, 10.0);
+      &g_mutex, &g_map, [&](const nav_msgs::OccupancyGrid& g) { return g.header.stamp > cleared; },
+      10.0);
   ASSERT_TRUE(empty);
   for (const std::int8_t v : empty->data) ASSERT_EQ(v, -1) << "a cell survived clear_region";
   const auto s = goodScanIntegrated(latestStatus()->inputs[0].integrated);
@@ -277,16 +279,6 @@ TEST_F(Hostile, SaveMapOnlyBelowMapDir) {
   for (const auto& f : save.response.files) std::remove(f.c_str());
 }
 
-/// Runs a command, returns its exit status; *output gets stdout and stderr.
-int run(const std::string& command, std::string* output) {
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[4096];
-  while (fgets(buffer, sizeof(buffer), pipe)) *output += buffer;
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 TEST(HostileStartUp, MapFileNotARegularFileFailsAtOnce) {
   const std::string pid = std::to_string(getpid());
   const std::string fifo = "/tmp/wavog_hostile_fifo_" + pid;
@@ -296,9 +288,9 @@ TEST(HostileStartUp, MapFileNotARegularFileFailsAtOnce) {
     std::string output;
     const ros::WallTime t0 = ros::WallTime::now();
     // timeout: a node blocked on the FIFO would exit 124, not 1.
-    const int code = run(std::string("timeout 20 ") + WAVOG_NODE_BIN + " __name:=hostile_" + pid +
-                             " map:=/hostile_" + pid + "/map _map_file:=" + file,
-                         &output);
+    const int code = room::run(std::string("timeout 20 ") + WAVOG_NODE_BIN + " __name:=hostile_" +
+                                   pid + " map:=/hostile_" + pid + "/map _map_file:=" + file,
+                               &output);
     EXPECT_EQ(code, 1) << output;
     EXPECT_NE(output.find("map_file"), std::string::npos) << output;
     EXPECT_NE(output.find(file), std::string::npos) << output;

@@ -8,18 +8,17 @@
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
-#include <sys/wait.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "room.h"
+#include "run_command.h"
 #include "wavog_mapping/MapperStatus.h"
 
 namespace {
@@ -220,21 +219,12 @@ TEST(NdtTopics, AdvertisedOnlyWithNdt) {
   EXPECT_TRUE(has("/plain/map_scale_2"));
 }
 
-/// Runs a command, returns its exit status; *output gets stdout and stderr.
-int run(const std::string& command, std::string* output) {
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[4096];
-  while (fgets(buffer, sizeof(buffer), pipe)) *output += buffer;
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 TEST(NdtTopics, BadMinWeightFailsAtStartUpNamingIt) {
   std::string output;
-  const int code = run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
-                           " __name:=badndt map:=/badndt/map _ndt:=true _ndt_min_weight:=-1.0",
-                       &output);
+  const int code =
+      room::run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
+                    " __name:=badndt map:=/badndt/map _ndt:=true _ndt_min_weight:=-1.0",
+                &output);
   EXPECT_EQ(code, 1) << output;
   EXPECT_NE(output.find("ndt_min_weight (-1) must be in [0, 1e6]"), std::string::npos) << output;
 }

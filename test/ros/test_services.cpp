@@ -8,10 +8,8 @@
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
-#include <cstdio>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -19,6 +17,7 @@
 #include <thread>
 
 #include "room.h"
+#include "run_command.h"
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/SaveMap.h"
 
@@ -51,20 +50,10 @@ bool exists(const std::string& path) {
   return stat(path.c_str(), &st) == 0;
 }
 
-/// Runs a command, returns its exit status; *output gets stdout and stderr.
-int run(const std::string& command, std::string* output) {
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[4096];
-  while (fgets(buffer, sizeof(buffer), pipe)) *output += buffer;
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-/// Asks a node started by run() to shut down (it would otherwise run until its timeout).
+/// Asks a node started by room::run() to shut down (it would otherwise run until its timeout).
 void stopNode(const std::string& name) {
   std::string ignored;
-  run("rosnode kill " + name, &ignored);
+  room::run("rosnode kill " + name, &ignored);
 }
 
 const std::string kDir = "/tmp/wavog_test_services_" + std::to_string(getpid());
@@ -134,7 +123,7 @@ TEST_F(Services, SaveMapWritesNativeAndMapServerFiles) {
                           " _map_file:=" + kMapFile;
   ros::param::set("/restored/resolution", 0.1);
   ros::param::set("/restored/block_levels", 6);
-  std::thread restored([&] { run(cmd, &output); });
+  std::thread restored([&] { room::run(cmd, &output); });
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20.0);
   while (ros::WallTime::now() < end && !get(g_restored)) ros::WallDuration(0.05).sleep();
   stopNode("/restored");
@@ -216,9 +205,9 @@ TEST_F(Services, PublishWindowLimitsTheGrid) {
           }));
   std::string output;
   std::thread node([&] {
-    run(std::string("timeout 20 ") + WAVOG_NODE_BIN +
-            " __name:=window map:=/window/map scan:=/window/scan",
-        &output);
+    room::run(std::string("timeout 20 ") + WAVOG_NODE_BIN +
+                  " __name:=window map:=/window/map scan:=/window/scan",
+              &output);
   });
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20.0);
   while (ros::WallTime::now() < end) {
@@ -379,9 +368,9 @@ TEST_F(Services, CorruptedMapFileFailsAtStartUp) {
   ros::param::set("/corrupt/resolution", 0.1);
   ros::param::set("/corrupt/block_levels", 6);
   std::string output;
-  const int code = run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
-                           " __name:=corrupt map:=/corrupt/map _map_file:=" + bad,
-                       &output);
+  const int code = room::run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
+                                 " __name:=corrupt map:=/corrupt/map _map_file:=" + bad,
+                             &output);
   EXPECT_EQ(code, 1) << output;
   EXPECT_NE(output.find("map_file"), std::string::npos) << output;
   EXPECT_NE(output.find(bad), std::string::npos) << output;
@@ -389,19 +378,19 @@ TEST_F(Services, CorruptedMapFileFailsAtStartUp) {
 
 TEST_F(Services, BadParameterFailsAtStartUpNamingIt) {
   std::string output;
-  const int code = run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
-                           " __name:=badparam map:=/badparam/map _publish_rate:=-2.0",
-                       &output);
+  const int code = room::run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
+                                 " __name:=badparam map:=/badparam/map _publish_rate:=-2.0",
+                             &output);
   EXPECT_EQ(code, 1) << output;
   EXPECT_NE(output.find("publish_rate (-2) must be in (0, 100] Hz"), std::string::npos) << output;
 }
 
 TEST_F(Services, NodeletWithBadParameterFailsToLoadNamingIt) {
   std::string output;
-  const int code = run("timeout 8 " + std::string(WAVOG_NODELET_BIN) +
-                           " standalone wavog_mapping/MappingNodelet __name:=badnodelet"
-                           " map:=/badnodelet/map _queue_size:=0",
-                       &output);
+  const int code = room::run("timeout 8 " + std::string(WAVOG_NODELET_BIN) +
+                                 " standalone wavog_mapping/MappingNodelet __name:=badnodelet"
+                                 " map:=/badnodelet/map _queue_size:=0",
+                             &output);
   EXPECT_NE(code, 0) << output;
   EXPECT_NE(code, 124) << "timed out instead of failing: " << output;
   EXPECT_NE(output.find("queue_size (0) must be in [1, 1000]"), std::string::npos) << output;
@@ -430,6 +419,6 @@ int main(int argc, char** argv) {
   ros::service::waitForService("wavog_mapping/reset", ros::Duration(20));
   const int result = RUN_ALL_TESTS();
   std::string ignored;
-  run("rm -rf " + kDir, &ignored);
+  room::run("rm -rf " + kDir, &ignored);
   return result;
 }

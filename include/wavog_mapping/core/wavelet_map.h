@@ -88,12 +88,19 @@ struct ReflectionRaster {
 /// One normal-distribution cell (MapParams::ndt): the Gaussian of the beam end-points that fell
 /// in a cell, weighted by the map's policy. At scale s it merges the finest cells' moments exactly.
 struct NdtCell {
-  std::int64_t ix = 0, iy = 0;             ///< the cell, in scale-s cell units
-  double weight = 0.0;                     ///< end-points it holds, as weighted by the policy
-  double mean_x = 0.0, mean_y = 0.0;       ///< mean of the end-points (map frame, m)
+  std::int64_t ix = 0, iy = 0;        ///< the cell, in scale-s cell units
+  double weight = 0.0;                ///< end-points it holds, as weighted by the policy
+  double mean_x = 0.0, mean_y = 0.0;  ///< mean of the end-points (map frame, m)
   double cov_xx = 0.0, cov_xy = 0.0, cov_yy = 0.0;  ///< their covariance (m^2; 0 for one point)
-  float log_odds = 0.0f;                   ///< the cell's occupancy at that scale (Haar average)
+  float log_odds = 0.0f;  ///< the cell's occupancy at that scale (Haar average)
 };
+
+/// The principal axes of a 2-D covariance: the standard deviations along its major and minor axes
+/// (a round-off negative eigenvalue is taken as 0) and the major axis' angle from x (rad).
+struct NdtAxes {
+  double sigma_major = 0.0, sigma_minor = 0.0, yaw = 0.0;
+};
+NdtAxes principalAxes(double cov_xx, double cov_xy, double cov_yy);
 
 /// The normal-distribution cells of one window at one scale (WaveletMap::exportNdt), sorted by
 /// (iy, ix); only cells holding a Gaussian appear.
@@ -104,6 +111,8 @@ struct NdtLayer {
   std::vector<NdtCell> cells;
 };
 
+/// P(occ) of a log-odds: 1 / (1 + exp(-log_odds)), in [0, 1].
+double probabilityFromLogOdds(float log_odds);
 /// OccupancyGrid value of a log-odds: round(100 * P(occ)), in 0..100.
 std::int8_t occupancyFromLogOdds(float log_odds);
 /// OccupancyGrid values of a raster, same order: -1 where unknown, else occupancyFromLogOdds.
