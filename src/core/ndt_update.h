@@ -76,11 +76,10 @@ struct NdtSpan {
   bool empty() const { return b1 == e1 && b2 == e2; }
   /// The entries under child q of the level-l square (their codes' bits 2(l-1), 2(l-1)+1 are q).
   void split(int l, NdtSpan out[4]) const {
-    NdtEntry* cuts1[5];
-    NdtEntry* cuts2[5];
-    cutRun(b1, e1, l, cuts1);
-    cutRun(b2, e2, l, cuts2);
-    for (int q = 0; q < 4; ++q) out[q] = {cuts1[q], cuts1[q + 1], cuts2[q], cuts2[q + 1]};
+    splitRun(b1, e1, l, &out[0].b1, &out[0].e1, &out[1].b1, &out[1].e1, &out[2].b1, &out[2].e1,
+             &out[3].b1, &out[3].e1);
+    splitRun(b2, e2, l, &out[0].b2, &out[0].e2, &out[1].b2, &out[1].e2, &out[2].b2, &out[2].e2,
+             &out[3].b2, &out[3].e2);
   }
   template <typename F>
   void forEach(F f) const {
@@ -89,15 +88,20 @@ struct NdtSpan {
   }
 
  private:
-  // The sorted run [b, e) cut by quadrant: child q's entries are [cuts[q], cuts[q + 1]).
-  static void cutRun(NdtEntry* b, NdtEntry* e, int l, NdtEntry* cuts[5]) {
+  static void splitRun(NdtEntry* b, NdtEntry* e, int l, NdtEntry** b0, NdtEntry** e0, NdtEntry** b1,
+                       NdtEntry** e1, NdtEntry** b2, NdtEntry** e2, NdtEntry** b3, NdtEntry** e3) {
     const int shift = 2 * (l - 1);
-    cuts[0] = b;
-    for (unsigned q = 0; q < 3; ++q) {
-      cuts[q + 1] = std::partition_point(
-          cuts[q], e, [shift, q](const NdtEntry& x) { return ((x.code >> shift) & 3u) <= q; });
-    }
-    cuts[4] = e;
+    const auto upto = [shift](unsigned q) {
+      return [shift, q](const NdtEntry& x) { return ((x.code >> shift) & 3u) <= q; };
+    };
+    NdtEntry* m0 = b == e ? e : std::partition_point(b, e, upto(0));
+    NdtEntry* m1 = m0 == e ? e : std::partition_point(m0, e, upto(1));
+    NdtEntry* m2 = m1 == e ? e : std::partition_point(m1, e, upto(2));
+    *b0 = b;
+    *e0 = *b1 = m0;
+    *e1 = *b2 = m1;
+    *e2 = *b3 = m2;
+    *e3 = e;
   }
 };
 
