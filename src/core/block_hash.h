@@ -12,6 +12,7 @@
 
 #include "ndt_store.h"
 #include "node_pool.h"
+#include "reflection_store.h"
 
 namespace wavog {
 namespace detail {
@@ -27,6 +28,8 @@ struct Block {
   std::vector<std::uint32_t> spare;
   /// MapParams::ndt: the Gaussians of its cells (made with the first end-point in the block).
   std::unique_ptr<NdtCells> ndt;
+  /// MapParams::reflection: the hits of its cells (made with the first hit in the block).
+  std::unique_ptr<HitCells> hits;
 };
 
 inline std::uint64_t blockKey(std::int64_t bx, std::int64_t by) {

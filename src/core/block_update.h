@@ -1,6 +1,7 @@
 // The update of one scan's blocks (integrate.cpp): the list of blocks a scan touches and the loop
 // that takes them one by one (from a counter shared by the threads of the scan) through the
-// quadtree update Integrator<P, kNdt> and, with MapParams::ndt, the update of their Gaussians.
+// quadtree update Integrator<P, kNdt, kHits> and, with MapParams::ndt, the update of their
+// Gaussians, with MapParams::reflection (kHits), that of their hits.
 // Not installed; included only by src/core/integrate*.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_BLOCK_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_BLOCK_UPDATE_H_
@@ -12,6 +13,7 @@
 #include "map_impl.h"
 #include "ndt_update.h"
 #include "quadtree_update.h"
+#include "reflection_update.h"
 
 namespace wavog {
 namespace detail {
@@ -26,30 +28,47 @@ struct BlockJob {
 
 // Updates the blocks jobs[i] for the indices i taken from `next` (shared by the threads of one
 // scan); node groups from `store`; with `ndt`, their Gaussians too (the walk finds the observed
-// ones when the policy forgets them: kNdt). Returns the nodes visited. The one place Integrator
-// is made, so the hot code is compiled once per policy (and once more with the Gaussians).
-template <PolicyType P, bool kNdt>
+// ones when the policy forgets them: kNdt); with kHits, their hits by `hits`. Returns the nodes
+// visited. The one place Integrator is made, so the hot code is compiled once per policy (and
+// once more with the Gaussians, and with the hits).
+template <PolicyType P, bool kNdt, bool kHits = false>
 [[gnu::noinline]] std::uint64_t updateBlocks(WaveletMap::Impl& impl, NodeStore& store,
                                              const ScanClassifier& cls, const PolicyConsts& pc,
-                                             const NdtConsts* ndt,
+                                             const NdtConsts* ndt, const HitConsts* hits,
                                              const std::vector<BlockJob>& jobs,
                                              std::atomic<std::size_t>* next) {
   NdtBlockUpdate ndt_update(cls, ndt != nullptr ? *ndt : NdtConsts{});
-  Integrator<P, kNdt> integrator(impl, store, cls, pc, &ndt_update);
+  HitBlockUpdate hit_update(impl, hits != nullptr ? *hits : HitConsts{});
+  Integrator<P, kNdt, kHits> integrator(impl, store, cls, pc, &ndt_update,
+                                        hit_update.observations());
   for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < jobs.size();
        i = next->fetch_add(1, std::memory_order_relaxed)) {
     const BlockJob& j = jobs[i];
     store.useSpare(&j.block->spare);
     if (ndt == nullptr || !j.block->ndt) {
       integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
-      continue;
+    } else {
+      const NdtSpan sp = ndt_update.begin(*j.block->ndt, j.ix0, j.iy0, j.points, j.points_end);
+      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box, kNdt ? sp : NdtSpan{});
+      ndt_update.finish();
     }
-    const NdtSpan sp = ndt_update.begin(*j.block->ndt, j.ix0, j.iy0, j.points, j.points_end);
-    integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box, kNdt ? sp : NdtSpan{});
-    ndt_update.finish();
+    if constexpr (kHits) hit_update.finish(*j.block, j.ix0, j.iy0);
   }
   return integrator.visited();
 }
+
+// The instantiations compiled apart from integrate.cpp (integrate_ndt.cpp,
+// integrate_reflection.cpp), so that they do not change how the compiler inlines the others:
+// WAVOG_UPDATE_BLOCKS(policy, kNdt, kHits) for each.
+#define WAVOG_UPDATE_BLOCKS_ALL                                   \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kForget, true, false)           \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kNone, false, true)             \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kMax, false, true)              \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kClamp, false, true)            \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kForget, false, true)           \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kClampLower, false, true)       \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kClampUpper, false, true)       \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kForget, true, true)
 
 }  // namespace detail
 }  // namespace wavog

@@ -1,6 +1,6 @@
 // Region clearing of WaveletMap: clearBox() sets every finest cell of a rectangle back to the
 // prior and unobserved, block by block and coarse to fine, pruning what becomes trivial; its
-// normal-distribution cells (MapParams::ndt) go too.
+// normal-distribution cells (MapParams::ndt) and hits (MapParams::reflection) go too.
 #include <array>
 #include <cmath>
 #include <vector>
@@ -55,7 +55,7 @@ double clearNode(WaveletMap::Impl& impl, detail::NodeStore& store, Node& n, int 
 std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, double max_y) {
   if (!(min_x <= max_x && min_y <= max_y)) return 0;  // also rejects NaN
   Impl& impl = *impl_;
-  for (WaveletMap* layer : {impl.hits.get(), impl.misses.get()}) {
+  for (WaveletMap* layer : {impl.hits_layer.get(), impl.misses_layer.get()}) {
     if (layer != nullptr) layer->clearBox(min_x, min_y, max_x, max_y);
   }
   const double r = impl.params.grid.resolution;
@@ -85,13 +85,16 @@ std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, doubl
       impl.eraseBlock(key);
       continue;
     }
-    if (b.ndt) {
-      b.ndt->removeIf([&](const detail::NdtEntry& e) {
-        std::uint32_t lx, ly;
-        detail::mortonCell(e.code, &lx, &ly);
-        const std::int64_t ix = x0 + lx, iy = y0 + ly;
-        return ix >= box.x0 && ix <= box.x1 && iy >= box.y0 && iy <= box.y1;
-      });
+    const auto in_box = [&](const auto& e) {
+      std::uint32_t lx, ly;
+      detail::mortonCell(e.code, &lx, &ly);
+      const std::int64_t ix = x0 + lx, iy = y0 + ly;
+      return ix >= box.x0 && ix <= box.x1 && iy >= box.y0 && iy <= box.y1;
+    };
+    if (b.ndt) b.ndt->removeIf(in_box);
+    if (b.hits) {
+      b.hits->counts.removeIf(in_box);
+      b.hits->ratios.removeIf(in_box);
     }
     // The block's groups stay with it (as in an integration, see NodeStore).
     detail::NodeStore store(impl.pool, &b.spare, &impl.nodes, impl.pool.liveCounter());

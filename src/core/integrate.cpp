@@ -20,9 +20,13 @@ namespace wavog {
 namespace detail {
 // The update with the Gaussians' forgetting is compiled in its own file (integrate_ndt.cpp), so
 // that it does not change how the compiler inlines the others.
-extern template std::uint64_t updateBlocks<PolicyType::kForget, true>(
-    WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&, const NdtConsts*,
-    const std::vector<BlockJob>&, std::atomic<std::size_t>*);
+// So are the updates with the hits of the reflection map (integrate_reflection.cpp).
+#define WAVOG_UPDATE_BLOCKS(P, NDT, HITS)                                                       \
+  extern template std::uint64_t updateBlocks<P, NDT, HITS>(                                    \
+      WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&,               \
+      const NdtConsts*, const HitConsts*, const std::vector<BlockJob>&, std::atomic<std::size_t>*);
+WAVOG_UPDATE_BLOCKS_ALL
+#undef WAVOG_UPDATE_BLOCKS
 }  // namespace detail
 
 namespace {
@@ -91,15 +95,21 @@ void orderByWork(const detail::PreparedScan& ps, double block_size,
 template <PolicyType P>
 std::uint64_t updateBlocksFor(WaveletMap::Impl& impl, detail::NodeStore& store,
                               const ScanClassifier& cls, const detail::PolicyConsts& pc,
-                              const detail::NdtConsts* ndt,
+                              const detail::NdtConsts* ndt, const detail::HitConsts* hits,
                               const std::vector<detail::BlockJob>& jobs,
                               std::atomic<std::size_t>* next) {
-  if constexpr (P == PolicyType::kForget) {  // the one policy whose observations change them
-    if (ndt != nullptr && ndt->forgets()) {
-      return detail::updateBlocks<P, true>(impl, store, cls, pc, ndt, jobs, next);
+  // The Gaussians: "forget" is the one policy whose observations change them.
+  const bool ndt_forgets = P == PolicyType::kForget && ndt != nullptr && ndt->forgets();
+  if (hits != nullptr) {
+    if (ndt_forgets) {
+      return detail::updateBlocks<P, true, true>(impl, store, cls, pc, ndt, hits, jobs, next);
     }
+    return detail::updateBlocks<P, false, true>(impl, store, cls, pc, ndt, hits, jobs, next);
   }
-  return detail::updateBlocks<P, false>(impl, store, cls, pc, ndt, jobs, next);
+  if (ndt_forgets) {
+    return detail::updateBlocks<P, true>(impl, store, cls, pc, ndt, hits, jobs, next);
+  }
+  return detail::updateBlocks<P, false>(impl, store, cls, pc, ndt, hits, jobs, next);
 }
 
 // `workers`: the map's worker threads (made here on first use), shared by its reflection layers.
@@ -155,6 +165,17 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
       }
     }
   }
+  // Reflection: the hits of the occupied cells (none to keep under kPrior and kLayers).
+  detail::HitConsts hit_consts;
+  const detail::HitConsts* hits = nullptr;
+  if (impl.reflection_mode == ReflectionMode::kDerived ||
+      impl.reflection_mode == ReflectionMode::kCounts) {
+    hit_consts.ratios = P == PolicyType::kForget;
+    hit_consts.a = a;
+    hit_consts.g = g;
+    hit_consts.basis = impl.reflection_basis;
+    hits = &hit_consts;
+  }
   st->blocks_touched = static_cast<std::uint32_t>(jobs.size());
   // The blocks are independent: each one's update reads only the scan and the parameters and
   // changes only its own nodes, taking node groups from its own spares (NodeStore), so the result
@@ -165,7 +186,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
   std::atomic<std::size_t> next{0};
   if (threads <= 1) {
     detail::NodeStore store(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
-    return visited + updateBlocksFor<P>(impl, store, cls, pc, ndt, jobs, &next);
+    return visited + updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
   }
   orderByWork(ps, block_size, &jobs);
   if (!*workers || (*workers)->threads() != threadsFor(p)) {
@@ -184,7 +205,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     if (tu >= active) return;
     Tally& tally = tallies[tu];
     detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
-    tally.visited = updateBlocksFor<P>(impl, store, cls, pc, ndt, jobs, &next);
+    tally.visited = updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
   });
   for (const Tally& tally : tallies) {
     visited += tally.visited;
@@ -222,8 +243,8 @@ IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& s
   st.touched = reachBox(ps.px, ps.py, ps.reach, ps.res);
   const auto policy = static_cast<std::size_t>(impl_->params.policy.type);
   st.nodes_visited = kIntegrateFor[policy](*impl_, classifier, scan.period, &impl_->workers, &st);
-  // The reflection layers (reflection.cpp) take the same classification and blocks.
-  for (WaveletMap* layer : {impl_->hits.get(), impl_->misses.get()}) {
+  // The reflection layers (reflection.cpp; kCounts, kLayers) take the same classification.
+  for (WaveletMap* layer : {impl_->hits_layer.get(), impl_->misses_layer.get()}) {
     if (layer == nullptr) continue;
     Impl& l = *layer->impl_;
     IntegrateStats layer_st;

@@ -6,9 +6,9 @@
 namespace wavog {
 namespace detail {
 
-template std::uint64_t updateBlocks<PolicyType::kForget, true>(
+template std::uint64_t updateBlocks<PolicyType::kForget, true, false>(
     WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&, const NdtConsts*,
-    const std::vector<BlockJob>&, std::atomic<std::size_t>*);
+    const HitConsts*, const std::vector<BlockJob>&, std::atomic<std::size_t>*);
 
 }  // namespace detail
 }  // namespace wavog

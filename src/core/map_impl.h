@@ -25,6 +25,17 @@ inline std::uint8_t withBit(unsigned mask, unsigned bit, bool on) {
 
 }  // namespace detail
 
+/// How a map keeps its reflection map (MapParams::reflection; reflection.cpp).
+enum class ReflectionMode : std::uint8_t {
+  kOff,      ///< no reflection map
+  kDerived,  ///< "none", or "forget" with the unknown prior: hits per hit cell, misses from the
+             ///< occupancy (ReflectionBasis)
+  kPrior,    ///< "forget" with the empty_bound prior: h from the occupancy alone, h + m = 1
+  kCounts,   ///< "max" and the clamps, or "none" restarted: hit counts per hit cell, misses in
+             ///< misses_layer (none under "max")
+  kLayers,   ///< "forget" restarted, or a version 2-3 file: hits and misses in two layers
+};
+
 /// Everything a WaveletMap holds. Members are public to the core's own translation units.
 struct WaveletMap::Impl {
   /// `validate`: throw std::invalid_argument for invalid parameters (a reflection layer's are
@@ -57,9 +68,12 @@ struct WaveletMap::Impl {
   detail::BlockMap blocks;
   /// Worker threads of parallel integrations (num_threads != 1), made on the first one.
   std::unique_ptr<detail::WorkerPool> workers;
-  /// Reflection layers (MapParams::reflection, reflection.cpp): hits and misses of every cell as
-  /// two more maps, integrated with the same classification; `misses` is null under "max".
-  std::unique_ptr<WaveletMap> hits, misses;
+  /// The reflection map (reflection.cpp): its mode, the policy, odd values and prior it has been
+  /// built under since the map was empty or it restarted, and the layers of kCounts and kLayers
+  /// (more maps, integrated with the same classification; misses_layer is null under "max").
+  ReflectionMode reflection_mode = ReflectionMode::kOff;
+  detail::ReflectionBasis reflection_basis;
+  std::unique_ptr<WaveletMap> hits_layer, misses_layer;
   std::size_t nodes = 0;  ///< live nodes (roots included)
   std::uint64_t nodes_visited_last = 0;
 
@@ -115,10 +129,16 @@ struct WaveletMap::Impl {
   /// Applies every pending tag in the map (before a policy change or a save).
   void flushAll();
 
-  /// Makes (or, after a policy change, re-parameterises) the reflection layers from params.
-  void configureLayers();
-  /// The parameters of reflection layer `hits` (else misses) of a map with `main`.
-  static MapParams layerParams(const MapParams& main, bool hits);
+  /// The basis of the reflection map under params.
+  detail::ReflectionBasis currentBasis() const;
+  /// Starts the reflection map afresh from no hits and no misses: in the mode of params' policy
+  /// when the occupancy is empty too (`fresh`), else in one that does not read the occupancy.
+  void restartReflection(bool fresh);
+  /// After a policy change: restarts the reflection map if its basis changed (the counts of one
+  /// policy mean something else under another), else re-parameterises its layers.
+  void configureReflection();
+  /// The parameters of reflection layer `hits` (else misses) of a map with `main` in `mode`.
+  static MapParams layerParams(const MapParams& main, bool hits, ReflectionMode mode);
 
   /// True when node `n` (after an update) carries no information beyond its parent's summary:
   /// no child, negligible details, uniform knowledge.

@@ -1,4 +1,4 @@
-// Native map files. Layout (little-endian, version 3):
+// Native map files. Layout (little-endian, version 4):
 //   "WAVOGMAP" | u32 version | f64 resolution | i32 block_levels | f64 prior | f64 a (the factor
 //   one pending unit stands for: 1 - gamma, or 2^-unit with forget_half_life) | u64 block count
 //   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
@@ -9,9 +9,14 @@
 //   u64 count of blocks with normal-distribution cells (MapParams::ndt), each: i32 bx | i32 by |
 //   u32 n | n cells ascending by Morton code within the block: u32 code | f64 w sx sy sxx sxy syy
 //   (moments about the cell's centre, ndt_store.h)
+//   u8 reflection mode (0 none, 1 derived, 2 prior, 3 counts, 4 layers: map_impl.h) | u8 policy |
+//   f64 odd_occ odd_emp prior (the basis it was built under) | u64 count of blocks with hits,
+//   each: i32 bx | i32 by | u8 kind (0 counts, 1 ratios) | u32 n | n cells ascending by code:
+//   u32 code | u32 count or f32 ratio (reflection_store.h)
 //   u32 CRC-32 (IEEE) of every byte before it.
-// Version 2 (before ndt) is the same without the last section, version 1 (before forget_half_life
-// and reflection) also with a u8 pending count and no layers; both still load.
+// Version 3 (before the hits) is the same without the reflection section (its layers hold the
+// hits and misses: kLayers), version 2 (before ndt) also without the NDT section, version 1
+// (before forget_half_life and reflection) also with a u8 pending count and no layers; all load.
 // Stored details and lazy counts are written as they are, so a round trip is bit-exact; a map
 // loaded under another factor applies the file's pending tags while loading.
 // Files are written and read through map_file.h (exclusive temporary + rename, regular files only).
@@ -24,6 +29,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "map_file.h"
@@ -37,7 +43,7 @@ using detail::Block;
 using detail::Node;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
-constexpr std::uint32_t kVersion = 3;
+constexpr std::uint32_t kVersion = 4;
 constexpr std::uint32_t kOldestVersion = 1;  // u8 pending counts
 // Fixed header: magic, version, resolution, block_levels, prior, forgetting factor, block count.
 constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
@@ -46,6 +52,9 @@ constexpr std::size_t kMinBlockBytes = 4 + 4 + 8 + 1;  // bx, by, average, flags
 constexpr std::size_t kNdtBlockBytes = 4 + 4 + 4;         // bx, by, cell count
 constexpr std::size_t kNdtCellBytes = 4 + 6 * 8;          // code, moments
 constexpr double kMaxNdtWeight = 1e15;  // end-points of one cell a file may claim
+constexpr std::size_t kHitBlockBytes = 4 + 4 + 1 + 4;     // bx, by, kind, cell count
+constexpr std::size_t kHitCellBytes = 4 + 4;              // code, count or ratio
+constexpr std::size_t kReflectionHeadBytes = 1 + 1 + 3 * 8 + 8;
 // Three details, k, mask, known bits.
 std::size_t nodeBytes(std::uint32_t version) { return 3 * 4 + (version == 1 ? 1 : 2) + 3; }
 
@@ -191,10 +200,17 @@ std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
                                                std::ldexp(1.0, 2 * levels) *
                                                    static_cast<double>(kNdtCellBytes))
                                   : 0.0;
-  if (static_cast<double>(size) > largest + ndt) {
+  // Version 4 adds the hits: at most every cell of every block.
+  const double hits = version >= 4 ? static_cast<double>(kReflectionHeadBytes) +
+                                         static_cast<double>(count) *
+                                             (static_cast<double>(kHitBlockBytes) +
+                                              std::ldexp(1.0, 2 * levels) *
+                                                  static_cast<double>(kHitCellBytes))
+                                   : 0.0;
+  if (static_cast<double>(size) > largest + ndt + hits) {
     throw fail(std::to_string(size) + " bytes, more than its " + std::to_string(count) +
                " blocks can fill (at most " +
-               std::to_string(static_cast<std::uint64_t>(largest + ndt)) +
+               std::to_string(static_cast<std::uint64_t>(largest + ndt + hits)) +
                " bytes at block_levels " + std::to_string(levels) + ")");
   }
   if (size > std::numeric_limits<std::size_t>::max()) throw fail("too large to read");
@@ -316,6 +332,121 @@ void readNdt(WaveletMap::Impl& fresh, bool keep, std::size_t bytes, Reader* r) {
   }
 }
 
+// The hits of one block's cells: u8 kind, u32 n, the live entries in code order.
+template <typename Entry>
+void writeHitRuns(const detail::CellRuns<Entry>& runs, std::int64_t bx, std::int64_t by,
+                  std::uint8_t kind, Writer* w) {
+  std::vector<Entry> cells;
+  for (const Entry& e : runs.entries) {
+    if (e.live()) cells.push_back(e);
+  }
+  if (cells.empty()) return;
+  std::sort(cells.begin(), cells.end(),
+            [](const Entry& a, const Entry& b) { return a.code < b.code; });
+  w->put(static_cast<std::int32_t>(bx));
+  w->put(static_cast<std::int32_t>(by));
+  w->put(kind);
+  w->put(static_cast<std::uint32_t>(cells.size()));
+  for (const Entry& e : cells) {
+    w->put(e.code);
+    if constexpr (std::is_same_v<Entry, detail::HitCount>) {
+      w->put(e.n);
+    } else {
+      w->put(e.q);
+    }
+  }
+}
+
+// The reflection section (version 4): mode, basis and the hits of every block holding some.
+void writeReflection(const WaveletMap::Impl& impl, Writer* w) {
+  w->put(static_cast<std::uint8_t>(impl.reflection_mode));
+  const detail::ReflectionBasis& b = impl.reflection_basis;
+  w->put(static_cast<std::uint8_t>(b.type));
+  w->put(b.odd_occ);
+  w->put(b.odd_emp);
+  w->put(b.init);
+  std::uint64_t count = 0;
+  for (const auto& kv : impl.blocks) {
+    if (!kv.second.hits) continue;
+    count += kv.second.hits->counts.empty() ? 0 : 1;
+    count += kv.second.hits->ratios.empty() ? 0 : 1;
+  }
+  w->put(count);
+  for (const auto& kv : impl.blocks) {
+    if (!kv.second.hits) continue;
+    const std::int64_t bx = detail::blockKeyX(kv.first), by = detail::blockKeyY(kv.first);
+    writeHitRuns(kv.second.hits->counts, bx, by, 0, w);
+    writeHitRuns(kv.second.hits->ratios, bx, by, 1, w);
+  }
+}
+
+// What a version-4 file says of its reflection map.
+struct FileReflection {
+  ReflectionMode mode = ReflectionMode::kOff;
+  detail::ReflectionBasis basis;
+};
+
+// Reads the reflection section into `fresh`'s blocks (read before); `keep`: false drops the hits.
+FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::size_t bytes, Reader* r) {
+  FileReflection f;
+  const auto mode = r->get<std::uint8_t>();
+  const auto type = r->get<std::uint8_t>();
+  if (mode > static_cast<std::uint8_t>(ReflectionMode::kLayers) ||
+      type > static_cast<std::uint8_t>(PolicyType::kClampUpper)) {
+    throw std::runtime_error("bad reflection mode");
+  }
+  f.mode = static_cast<ReflectionMode>(mode);
+  f.basis.type = static_cast<PolicyType>(type);
+  f.basis.odd_occ = r->get<double>();
+  f.basis.odd_emp = r->get<double>();
+  f.basis.init = r->get<double>();
+  const auto count = r->get<std::uint64_t>();
+  if (count > bytes / kHitBlockBytes) throw std::runtime_error("bad hit block count");
+  const std::uint64_t cells_per_block = std::uint64_t{1} << (2 * fresh.levels);
+  for (std::uint64_t i = 0; i < count; ++i) {
+    const auto bx = r->get<std::int32_t>();
+    const auto by = r->get<std::int32_t>();
+    const auto kind = r->get<std::uint8_t>();
+    const auto n = r->get<std::uint32_t>();
+    Block* b = fresh.findBlock(bx, by);
+    if (b == nullptr) throw std::runtime_error("hits in a block the file does not hold");
+    if (kind > 1) throw std::runtime_error("bad hit kind");
+    if (n == 0 || n > cells_per_block || n > bytes / kHitCellBytes) {
+      throw std::runtime_error("bad hit cell count");
+    }
+    if (!b->hits) b->hits = std::make_unique<detail::HitCells>();
+    const auto fill = [&](auto* runs) {
+      if (!runs->entries.empty()) throw std::runtime_error("duplicate hit block");
+      runs->entries.resize(n);
+      for (std::uint32_t j = 0; j < n; ++j) {
+        auto& e = runs->entries[j];
+        e.code = r->get<std::uint32_t>();
+        if (e.code >= cells_per_block || (j > 0 && e.code <= runs->entries[j - 1].code)) {
+          throw std::runtime_error("hit cells out of order");
+        }
+        using Entry = std::decay_t<decltype(e)>;
+        if constexpr (std::is_same_v<Entry, detail::HitCount>) {
+          e.n = r->get<std::uint32_t>();
+        } else {
+          e.q = r->get<float>();
+          if (!std::isfinite(e.q)) throw std::runtime_error("non-finite hit ratio");
+        }
+        if (!e.live()) throw std::runtime_error("empty hit cell");
+      }
+      runs->sorted = n;
+    };
+    if (kind == 0) {
+      fill(&b->hits->counts);
+    } else {
+      fill(&b->hits->ratios);
+    }
+  }
+  if (!keep) {
+    for (auto& kv : fresh.blocks) kv.second.hits.reset();
+  }
+  return f;
+}
+
 double readUnitFactor(Reader* r) {
   const auto a = r->get<double>();
   if (!(a >= 0.0 && a <= 1.0)) throw std::runtime_error("bad forgetting factor");
@@ -334,17 +465,17 @@ void WaveletMap::save(const std::string& path) const {
   w.put(impl.init);
   w.put(impl.unitFactor());
   writeBlocks(impl, &w);
-  // Reflection layers: u8 count (0: none, 1: hits, 2: hits and misses), each its unit factor and
-  // its blocks.
-  const std::vector<const WaveletMap*> layers = {impl.hits.get(), impl.misses.get()};
-  const auto n = static_cast<std::uint8_t>((layers[0] != nullptr) + (layers[1] != nullptr));
-  w.put(n);
-  for (std::uint8_t i = 0; i < n; ++i) {
-    const Impl& l = *layers[i]->impl_;
+  // Reflection layers: u8 mask (1: hits, 2: misses), each its unit factor and its blocks.
+  const WaveletMap* layers[2] = {impl.hits_layer.get(), impl.misses_layer.get()};
+  w.put(static_cast<std::uint8_t>((layers[0] != nullptr ? 1 : 0) | (layers[1] != nullptr ? 2 : 0)));
+  for (const WaveletMap* layer : layers) {
+    if (layer == nullptr) continue;
+    const Impl& l = *layer->impl_;
     w.put(l.unitFactor());
     writeBlocks(l, &w);
   }
   writeNdt(impl, &w);
+  writeReflection(impl, &w);
   auto& buf = w.buffer();
   const std::uint32_t crc = crc32(buf.data(), buf.size());
   w.put(crc);
@@ -381,21 +512,48 @@ void WaveletMap::load(const std::string& path) {
     }
     readBlocks(fresh, PendingFormat{version, file_a, file_a == fresh.unitFactor()}, data.size(),
                &r);
+    // Reflection layers (version >= 2), read into maps of the file's layers.
+    std::unique_ptr<WaveletMap> file_layers[2];
     if (version >= 2) {
-      // Reflection layers: into this map's when it keeps them (a missing one stays empty), else
-      // read and dropped.
+      // Version 4: a mask of the layers; before, their count (hits first).
       const auto n = r.get<std::uint8_t>();
-      if (n > 2) throw std::runtime_error("bad reflection layer count");
-      for (std::uint8_t i = 0; i < n; ++i) {
-        WaveletMap* mine = i == 0 ? fresh.hits.get() : fresh.misses.get();
-        Impl dropped(Impl::layerParams(impl_->params, i == 0), false);
-        Impl& into = mine != nullptr ? *mine->impl_ : dropped;
+      if (n > 3 || (version < 4 && n > 2)) throw std::runtime_error("bad reflection layers");
+      const unsigned mask = version >= 4 ? n : (1u << n) - 1u;
+      for (int i = 0; i < 2; ++i) {
+        if (!((mask >> i) & 1u)) continue;
+        file_layers[i].reset(new WaveletMap(
+            Impl::layerParams(impl_->params, i == 0, ReflectionMode::kLayers), LayerTag{}));
+        Impl& into = *file_layers[i]->impl_;
         const double layer_a = readUnitFactor(&r);
         readBlocks(into, PendingFormat{version, layer_a, layer_a == into.unitFactor()}, data.size(),
                    &r);
       }
     }
     if (version >= 3) readNdt(fresh, impl_->params.ndt, data.size(), &r);
+    FileReflection file;
+    if (version >= 4) {
+      file = readReflection(fresh, impl_->params.reflection, data.size(), &r);
+    } else if (file_layers[0]) {
+      file.mode = ReflectionMode::kLayers;  // the hits and misses of older files
+      file.basis = fresh.currentBasis();  // not recorded; the layers count whatever it was
+    }
+    // The file's reflection map when it was built under this map's basis and holds the layers
+    // its mode needs, else a restart.
+    if (impl_->params.reflection) {
+      const bool needs_misses = impl_->params.policy.type != PolicyType::kMax &&
+                                (file.mode == ReflectionMode::kLayers ||
+                                 file.mode == ReflectionMode::kCounts);
+      const bool complete =
+          (file.mode != ReflectionMode::kLayers || file_layers[0] != nullptr) &&
+          (needs_misses ? file_layers[1] != nullptr : file_layers[1] == nullptr);
+      if (file.mode != ReflectionMode::kOff && file.basis == fresh.currentBasis() && complete) {
+        fresh.reflection_mode = file.mode;
+        fresh.hits_layer = std::move(file_layers[0]);
+        fresh.misses_layer = std::move(file_layers[1]);  // made with this map's layer parameters
+      } else {
+        fresh.restartReflection(fresh.blocks.empty());
+      }
+    }
     if (!r.done()) throw std::runtime_error("trailing bytes");
   } catch (const MapIoError&) {
     throw;

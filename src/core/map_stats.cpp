@@ -33,16 +33,25 @@ MapStats WaveletMap::stats(bool count_observed) const {
   for (const auto& kv : impl.blocks) spare += kv.second.spare.capacity() * sizeof(std::uint32_t);
   const std::size_t rest = impl.blocks.size() * per_block +
                            impl.blocks.bucket_count() * sizeof(void*) + sizeof(Impl) + spare;
+  std::size_t hit_bytes = 0;
+  for (const auto& kv : impl.blocks) {
+    const detail::HitCells* hits = kv.second.hits.get();
+    if (hits == nullptr) continue;
+    hit_bytes += sizeof(detail::HitCells) +
+                 hits->counts.entries.capacity() * sizeof(detail::HitCount) +
+                 hits->ratios.entries.capacity() * sizeof(detail::HitRatio);
+  }
+  st.reflection_bytes = hit_bytes;
   for (const auto& kv : impl.blocks) {
     const detail::NdtCells* ndt = kv.second.ndt.get();
     if (ndt == nullptr) continue;
     st.ndt_cells += ndt->entries.size() - ndt->dead;
     st.ndt_bytes += sizeof(detail::NdtCells) + ndt->entries.capacity() * sizeof(detail::NdtEntry);
   }
-  st.bytes = impl.pool.bytes() + rest + st.ndt_bytes;
-  st.bytes_reserved = impl.pool.bytesReserved() + rest + st.ndt_bytes;
+  st.bytes = impl.pool.bytes() + rest + st.ndt_bytes + hit_bytes;
+  st.bytes_reserved = impl.pool.bytesReserved() + rest + st.ndt_bytes + hit_bytes;
   st.nodes_visited_last = impl.nodes_visited_last;
-  for (const WaveletMap* layer : {impl.hits.get(), impl.misses.get()}) {
+  for (const WaveletMap* layer : {impl.hits_layer.get(), impl.misses_layer.get()}) {
     if (layer == nullptr) continue;
     const MapStats ls = layer->stats();
     st.reflection_bytes += ls.bytes;

@@ -19,7 +19,7 @@ WaveletMap::Impl::Impl(const MapParams& p, bool validate) : params(p) {
   if (validate) throwIfInvalid(p);
   levels = p.grid.block_levels;
   configure();
-  configureLayers();
+  restartReflection(true);
 }
 
 void WaveletMap::Impl::configure() {

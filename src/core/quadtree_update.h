@@ -3,7 +3,8 @@
 // own scale (a lazy tag with forgetting), the rest descends; the children's average changes fold
 // into the parent's details with one forward Haar step. With kNdt (MapParams::ndt and "forget")
 // the walk also carries the span of the block's Gaussians under each square and forgets those the
-// scan observes (ndt_update.h). Not installed; included only by src/core/integrate.cpp.
+// scan observes (ndt_update.h); with kHits (MapParams::reflection) it lists the occupied cells
+// (reflection_update.h). Not installed; included only by src/core/integrate*.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 
@@ -11,9 +12,11 @@
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
+#include <vector>
 
 #include "map_slot.h"
 #include "ndt_update.h"
+#include "reflection_store.h"
 #include "scan_classifier.h"
 #include "update_policy.h"
 #include "wavog_mapping/core/haar.h"
@@ -30,21 +33,24 @@ struct NoSpans {
   }
 };
 
-template <PolicyType P, bool kNdt = false>
+template <PolicyType P, bool kNdt = false, bool kHits = false>
 class Integrator {
   using Spans = std::conditional_t<kNdt, std::array<NdtSpan, 4>, NoSpans>;
 
  public:
   /// Node groups come from and go to `store` (one Integrator per thread); with kNdt, the
-  /// Gaussians' forgetting goes to `ndt`.
+  /// Gaussians' forgetting goes to `ndt`; with kHits, the occupied cells go to `hits`.
   Integrator(WaveletMap::Impl& impl, NodeStore& store, const ScanClassifier& classifier,
-             const PolicyConsts& pc, NdtBlockUpdate* ndt = nullptr)
+             const PolicyConsts& pc, NdtBlockUpdate* ndt = nullptr,
+             std::vector<HitObservation>* hits = nullptr)
       : impl_(impl),
         store_(store),
         cls_(classifier),
         pc_(pc),
         lazy_(impl.params.lazy_forgetting),
-        ndt_(ndt) {}
+        ndt_(ndt),
+        hits_(hits),
+        cell_mask_((std::int64_t{1} << impl.levels) - 1) {}
 
   /// Tree nodes and finest cells visited so far.
   std::uint64_t visited() const { return visited_; }
@@ -164,13 +170,15 @@ class Integrator {
       cells.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << q;
       cells.o |= static_cast<std::uint32_t>(cls == CellClass::kOccupied) << q;
     }
-    return updateCells(n, cells, s);
+    return updateCells(n, cells, s, ix0, iy0);
   }
 
-  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), cell q
-  // E or O by bit q of `cells` (U when in neither), and to the Gaussians of those cells (the
-  // slot's span); returns the change of n's average.
-  double updateCells(Node& n, const CellMasks& cells, double s) {
+  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed, origin
+  // cell ix0, iy0), cell q E or O by bit q of `cells` (U when in neither), and to the Gaussians
+  // of those cells (the slot's span); with kHits, lists its O cells; returns the change of n's
+  // average.
+  double updateCells(Node& n, const CellMasks& cells, double s, std::int64_t ix0,
+                     std::int64_t iy0) {
     visited_ += 4;
     if constexpr (kNdt) {
       const std::uint32_t observed = cells.e | cells.o;
@@ -179,6 +187,17 @@ class Integrator {
       });
     }
     const std::array<double, 4> c = haar::backward(s, n.d);
+    if constexpr (kHits) {
+      for (std::uint32_t o = cells.o; o != 0; o &= o - 1) {
+        const auto q = static_cast<unsigned>(__builtin_ctz(o));
+        const auto lx = static_cast<std::uint32_t>((ix0 + (q & 1u)) & cell_mask_);
+        const auto ly = static_cast<std::uint32_t>((iy0 + (q >> 1)) & cell_mask_);
+        hits_->push_back({mortonCode(lx, ly), c[q]});
+      }
+    } else {
+      (void)ix0;
+      (void)iy0;
+    }
     std::array<double, 4> delta{};
     for (std::size_t q = 0; q < 4; ++q) {
       if ((cells.e >> q) & 1u) {
@@ -216,7 +235,7 @@ class Integrator {
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
-        return updateCells(m, cc, c[qu]);
+        return updateCells(m, cc, c[qu], ix0 + (q & 1) * 2, iy0 + (q >> 1) * 2);
       });
     }
     return foldChanges(n, delta);
@@ -249,6 +268,8 @@ class Integrator {
   const PolicyConsts pc_;
   const bool lazy_;
   NdtBlockUpdate* const ndt_;
+  std::vector<HitObservation>* const hits_;
+  const std::int64_t cell_mask_;  // a finest cell's index within its block
   // kNdt: the Gaussians under the slot being updated and a classification holding it. A visit
   // reads them on entry (children set them again, one after the other).
   NdtSpan slot_span_;

@@ -1,9 +1,13 @@
-// The reflection probability map (MapParams::reflection; paper section 1.2.2, eq. 1.3): the hits
-// and misses of every cell are two more maps of the same kind, with the map's policy and odd
-// values that count: hits add 1 in the occupied band and 0 in free space, misses the other way
-// round. They are integrated with the main map's classification of each scan (integrate.cpp), so
-// coarse E updates stay coarse and forgetting stays lazy; p at scale s is the ratio of their Haar
-// averages, exact at every scale.
+// The reflection probability map (MapParams::reflection; paper section 1.2.2, eq. 1.3): p = h /
+// (h + m) from the hits h (beams that ended in a cell: the occupied band) and misses m (beams
+// that crossed it: E cells) of every cell, under the map's policy. Hits are kept only for the
+// cells that were hit (reflection_store.h, updated by reflection_update.h); misses are read from
+// the occupancy itself wherever it is a linear function of the counts, which it is when the map
+// has applied "none", or "forget", with the same odd values and prior since it was empty
+// (ReflectionBasis; docs/algorithm.md). So free space costs nothing more to update. The clamps
+// are not linear: their misses are counted in a layer, another map of the same kind integrated
+// with the main map's classification of each scan. p at scale s is the ratio of the sums over
+// the cells under each coarse cell, exact at every scale.
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -13,82 +17,213 @@
 
 namespace wavog {
 
-MapParams WaveletMap::Impl::layerParams(const MapParams& main, bool hits) {
+using detail::Block;
+
+MapParams WaveletMap::Impl::layerParams(const MapParams& main, bool hits, ReflectionMode mode) {
   MapParams p = main;
   p.reflection = false;
   p.ndt = false;
-  p.policy.init = InitValue::kUnknown;  // no count yet
   // Forgetting forgets the counts by the map's gamma; every other policy counts (see params.h).
-  p.policy.type = main.policy.type == PolicyType::kForget ? PolicyType::kForget : PolicyType::kNone;
+  const bool forget = mode == ReflectionMode::kLayers && main.policy.type == PolicyType::kForget;
+  p.policy.type = forget ? PolicyType::kForget : PolicyType::kNone;
+  // No count yet; with forgetting and the empty_bound prior, a cell starts as one full miss (its
+  // empty bound, as the occupancy does): h + m = 1.
+  p.policy.init = forget && !hits ? main.policy.init : InitValue::kUnknown;
   p.sensor.odd_occ = hits ? 1.0 : 0.0;
   p.sensor.odd_emp = hits ? 0.0 : 1.0;
   return p;
 }
 
-void WaveletMap::Impl::configureLayers() {
-  if (!params.reflection) return;
-  const bool with_misses = params.policy.type != PolicyType::kMax;  // "max": hits only
-  const auto update = [](std::unique_ptr<WaveletMap>* layer, const MapParams& p) {
-    if (!*layer) {
-      layer->reset(new WaveletMap(p, LayerTag{}));
-      return;
+detail::ReflectionBasis WaveletMap::Impl::currentBasis() const {
+  return {params.policy.type, params.sensor.odd_occ, params.sensor.odd_emp, params.initValue()};
+}
+
+void WaveletMap::Impl::restartReflection(bool fresh) {
+  for (auto& kv : blocks) kv.second.hits.reset();
+  hits_layer.reset();
+  misses_layer.reset();
+  reflection_basis = currentBasis();
+  if (!params.reflection) {
+    reflection_mode = ReflectionMode::kOff;
+    return;
+  }
+  const PolicyType type = params.policy.type;
+  if (type == PolicyType::kForget) {
+    if (!fresh) {
+      reflection_mode = ReflectionMode::kLayers;
+    } else {
+      reflection_mode = params.policy.init == InitValue::kUnknown ? ReflectionMode::kDerived
+                                                                  : ReflectionMode::kPrior;
     }
+  } else if (type == PolicyType::kNone && fresh) {
+    reflection_mode = ReflectionMode::kDerived;
+  } else {
+    reflection_mode = ReflectionMode::kCounts;
+  }
+  const auto make = [this](std::unique_ptr<WaveletMap>* layer, bool hits) {
+    layer->reset(new WaveletMap(layerParams(params, hits, reflection_mode), LayerTag{}));
+  };
+  if (reflection_mode == ReflectionMode::kLayers) make(&hits_layer, true);
+  const bool layer_misses = type != PolicyType::kMax && (reflection_mode == ReflectionMode::kLayers ||
+                                                         reflection_mode == ReflectionMode::kCounts);
+  if (layer_misses) make(&misses_layer, false);
+}
+
+void WaveletMap::Impl::configureReflection() {
+  if (!params.reflection) return;
+  if (currentBasis() != reflection_basis) {
+    restartReflection(blocks.empty());
+    return;
+  }
+  for (std::unique_ptr<WaveletMap>* layer : {&hits_layer, &misses_layer}) {
+    if (!*layer) continue;
     Impl& impl = *(*layer)->impl_;
     impl.flushAll();  // pending counts stand for the old factor
-    impl.params = p;
+    impl.params = layerParams(params, layer == &hits_layer, reflection_mode);
     impl.configure();
-  };
-  update(&hits, layerParams(params, true));
-  if (with_misses) {
-    update(&misses, layerParams(params, false));
-  } else {
-    misses.reset();
   }
 }
 
 namespace {
 
-// p from the hits and misses averages of one cell or raster cell.
-float probability(bool known, double h, const WaveletMap* misses, double m) {
-  if (!known) return std::numeric_limits<float>::quiet_NaN();
-  if (misses == nullptr) return h > 0.0 ? 1.0f : 0.0f;
-  const double total = h + m;  // float details may leave a count a hair below 0
-  if (!(total > 0.0)) return std::numeric_limits<float>::quiet_NaN();
+const WaveletMap::Impl& requireReflection(const WaveletMap::Impl& impl) {
+  if (impl.reflection_mode == ReflectionMode::kOff) {
+    throw std::logic_error("this map keeps no reflection map (MapParams::reflection)");
+  }
+  return impl;
+}
+
+// p of one cell or raster cell from its mean hits and misses (NaN: nothing observed).
+float probability(double h, double m) {
+  const double total = h + m;  // float round-off may leave a count a hair below 0
+  if (!(total > 0.0)) return h > 0.0 ? 1.0f : 0.0f;
   return static_cast<float>(std::fmin(1.0, std::fmax(0.0, h / total)));
 }
 
-const WaveletMap& hitsOf(const WaveletMap::Impl& impl) {
-  if (!impl.hits)
-    throw std::logic_error("this map keeps no reflection layer (MapParams::reflection)");
-  return *impl.hits;
+// The hits of the cell (ix, iy) of an entry (under "forget", read with its occupancy).
+double hitsOf(const WaveletMap::Impl&, const detail::HitCount& e, std::int64_t, std::int64_t) {
+  return static_cast<double>(e.n);
+}
+double hitsOf(const WaveletMap::Impl& impl, const detail::HitRatio& e, std::int64_t ix,
+              std::int64_t iy) {
+  return impl.reflection_basis.hitsFromRatio(impl.read(0, ix, iy).average, e.q);
+}
+
+// Adds the hits of every hit cell in `window` (scale-s cells) to `sums`, row-major.
+template <typename Entry>
+void addHits(const WaveletMap::Impl& impl, const detail::CellRuns<Entry>& runs, std::int64_t x0,
+             std::int64_t y0, int s, const CellBox& window, std::vector<double>* sums) {
+  for (const Entry& e : runs.entries) {
+    if (!e.live()) continue;
+    std::uint32_t lx, ly;
+    detail::mortonCell(e.code, &lx, &ly);
+    const std::int64_t ix = x0 + lx, iy = y0 + ly;
+    const std::int64_t rx = ix >> s, ry = iy >> s;
+    if (rx < window.min_x || rx >= window.max_x || ry < window.min_y || ry >= window.max_y) continue;
+    (*sums)[static_cast<std::size_t>((ry - window.min_y) * window.width() + (rx - window.min_x))] +=
+        hitsOf(impl, e, ix, iy);
+  }
+}
+
+// The mean hits of every scale-s cell of `window`, row-major.
+std::vector<double> meanHits(const WaveletMap::Impl& impl, int s, const CellBox& window) {
+  std::vector<double> sums(static_cast<std::size_t>(window.width() * window.height()), 0.0);
+  const int L = impl.levels;
+  const std::int64_t span = std::int64_t{1} << (L - s);  // scale-s cells per block side
+  for (const auto& kv : impl.blocks) {
+    const Block& b = kv.second;
+    if (!b.hits || b.hits->empty()) continue;
+    const std::int64_t bx = detail::blockKeyX(kv.first), by = detail::blockKeyY(kv.first);
+    if ((bx + 1) * span <= window.min_x || bx * span >= window.max_x ||
+        (by + 1) * span <= window.min_y || by * span >= window.max_y) {
+      continue;
+    }
+    const std::int64_t x0 = detail::scaleUp(bx, L), y0 = detail::scaleUp(by, L);
+    addHits(impl, b.hits->counts, x0, y0, s, window, &sums);
+    addHits(impl, b.hits->ratios, x0, y0, s, window, &sums);
+  }
+  const double cells = std::ldexp(1.0, 2 * s);
+  for (double& v : sums) v /= cells;
+  return sums;
+}
+
+// p of an observed cell or raster cell of mean log-odds `l` (the hits layer's mean under
+// kLayers), mean hits `h` (kDerived, kCounts) and mean misses of the misses layer `m`.
+float fromCounts(const WaveletMap::Impl& impl, double l, double h, double m) {
+  switch (impl.reflection_mode) {
+    case ReflectionMode::kDerived:
+      return probability(h, impl.reflection_basis.misses(l, h));
+    case ReflectionMode::kPrior: {
+      const double prior_h = impl.reflection_basis.hitsFromRatio(l, 0.0f);  // h + m = 1
+      return probability(prior_h, 1.0 - prior_h);
+    }
+    case ReflectionMode::kCounts:
+      return probability(h, m);
+    case ReflectionMode::kLayers:
+      return probability(l, m);
+    case ReflectionMode::kOff:
+      break;
+  }
+  return std::numeric_limits<float>::quiet_NaN();
 }
 
 }  // namespace
 
 ReflectionRaster WaveletMap::exportReflection(int scale, const CellBox& window) const {
-  const WaveletMap& hits = hitsOf(*impl_);
-  const WaveletMap* misses = impl_->misses.get();
-  // Hits and misses share the main map's classification, so their knowledge is the same.
-  const Raster h = hits.exportScale(scale, window, Aggregation::kMean);
-  Raster m;
-  if (misses != nullptr) m = misses->exportScale(scale, window, Aggregation::kMean);
+  const Impl& impl = requireReflection(*impl_);
+  const ReflectionMode mode = impl.reflection_mode;
+  // Every count shares the main map's classification, so the knowledge is the main map's, or,
+  // since a restart, that of the layers (the hits layer's, or the misses layer's under kCounts).
+  const Raster main = mode == ReflectionMode::kLayers
+                          ? impl.hits_layer->exportScale(scale, window, Aggregation::kMean)
+                          : exportScale(scale, window, Aggregation::kMean);
+  Raster misses;
+  if (impl.misses_layer) misses = impl.misses_layer->exportScale(scale, window, Aggregation::kMean);
+  const std::vector<std::uint8_t>& known =
+      mode == ReflectionMode::kCounts && impl.misses_layer ? misses.known : main.known;
   ReflectionRaster r;
-  r.scale = h.scale;
-  r.cell_size = h.cell_size;
-  r.box = h.box;
-  r.p.resize(h.log_odds.size());
+  r.scale = main.scale;
+  r.cell_size = main.cell_size;
+  r.box = main.box;
+  r.p.assign(main.log_odds.size(), std::numeric_limits<float>::quiet_NaN());
+  std::vector<double> hits;
+  if (mode == ReflectionMode::kDerived || mode == ReflectionMode::kCounts) {
+    hits = meanHits(impl, r.scale, r.box);
+  }
   for (std::size_t i = 0; i < r.p.size(); ++i) {
-    r.p[i] = probability(h.known[i] != 0, h.log_odds[i], misses,
-                         misses != nullptr ? m.log_odds[i] : 0.0);
+    if (known[i] == 0) continue;
+    r.p[i] = fromCounts(impl, main.log_odds[i], hits.empty() ? 0.0 : hits[i],
+                        impl.misses_layer ? misses.log_odds[i] : 0.0);
   }
   return r;
 }
 
 float WaveletMap::reflection(const CellIndex& cell) const {
-  const WaveletMap& hits = hitsOf(*impl_);
-  const WaveletMap* misses = impl_->misses.get();
-  return probability(hits.isObserved(cell), hits.value(cell), misses,
-                     misses != nullptr ? misses->value(cell) : 0.0);
+  const Impl& impl = requireReflection(*impl_);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const double m = impl.misses_layer ? impl.misses_layer->value(cell) : 0.0;
+  if (impl.reflection_mode == ReflectionMode::kLayers) {
+    const WaveletMap& hits = *impl.hits_layer;
+    return hits.isObserved(cell) ? fromCounts(impl, hits.value(cell), 0.0, m) : nan;
+  }
+  const bool counted_misses = impl.reflection_mode == ReflectionMode::kCounts && impl.misses_layer;
+  if (!(counted_misses ? impl.misses_layer->isObserved(cell) : isObserved(cell))) return nan;
+  const int L = impl.levels;
+  const std::int64_t mask = (std::int64_t{1} << L) - 1;
+  const double l = impl.read(0, cell.x, cell.y).average;
+  double h = 0.0;
+  const Block* b = impl.findBlock(detail::floorShift(cell.x, L), detail::floorShift(cell.y, L));
+  if (b != nullptr && b->hits) {
+    const auto code = detail::mortonCode(static_cast<std::uint32_t>(cell.x & mask),
+                                         static_cast<std::uint32_t>(cell.y & mask));
+    if (const detail::HitCount* e = b->hits->counts.find(code); e != nullptr && e->live()) {
+      h = hitsOf(impl, *e, cell.x, cell.y);
+    }
+    if (const detail::HitRatio* e = b->hits->ratios.find(code); e != nullptr && e->live()) {
+      h = hitsOf(impl, *e, cell.x, cell.y);
+    }
+  }
+  return fromCounts(impl, l, h, m);
 }
 
 std::vector<std::int8_t> toOccupancyGrid(const ReflectionRaster& raster) {

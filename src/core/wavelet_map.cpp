@@ -77,9 +77,7 @@ void WaveletMap::reset() {
   impl_->blocks.clear();
   impl_->pool.clear();
   impl_->nodes = 0;
-  for (WaveletMap* layer : {impl_->hits.get(), impl_->misses.get()}) {
-    if (layer != nullptr) layer->reset();
-  }
+  impl_->restartReflection(true);  // the occupancy is empty again
 }
 
 void WaveletMap::setPolicy(const PolicyParams& policy, const SensorModelParams& sensor) {
@@ -91,7 +89,7 @@ void WaveletMap::setPolicy(const PolicyParams& policy, const SensorModelParams& 
   const double old_init = impl_->init;
   impl_->params = p;
   impl_->configure();
-  impl_->configureLayers();
+  impl_->configureReflection();
   // Never-observed space follows the new prior: uniform unobserved blocks are the only place it
   // is stored without a cell of its own (missing blocks read as the prior already).
   if (impl_->init != old_init) {

@@ -1,9 +1,10 @@
 // The reflection probability map (MapParams::reflection): against a dense reference that counts
 // hits and misses cell by cell (DenseReference layers with the spec's updates: "none" and the
 // clamp policies add 1 to hits in the occupied band and to misses in free space, "forget" applies
-// h <- (1-g) h + g [hit], m <- (1-g) m + g [miss], "max" counts hits only), for every policy, on
-// random scans with every bad beam kind and on the first fr079 scans, at every scale; files,
-// clearing and policy changes; off by default.
+// h <- (1-g) h + g [hit], m <- (1-g) m + g [miss] from h = m = 0, or m = 1 with the empty_bound
+// prior, "max" counts hits only), for every policy and prior, on random scans with every bad beam
+// kind and on the first fr079 scans, at every scale; restarts after policy changes; files of every
+// mode, clearing; off by default.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -27,32 +28,56 @@ using wavog::WaveletMap;
 
 constexpr double kTolerance = 1e-4;
 
-// The reference's counting layer: hits (or misses) of the spec for the map's policy.
+// The reference's counting layer: hits (or misses) of the spec for the map's policy. With
+// forgetting and the empty_bound prior a cell starts as one full miss (the layer's empty bound).
 MapParams countingLayer(const MapParams& main, bool hits) {
   MapParams p = main;
-  p.policy.type = main.policy.type == PolicyType::kForget ? PolicyType::kForget : PolicyType::kNone;
-  p.policy.init = wavog::InitValue::kUnknown;
+  const bool forget = main.policy.type == PolicyType::kForget;
+  p.policy.type = forget ? PolicyType::kForget : PolicyType::kNone;
+  p.policy.init = forget ? main.policy.init : wavog::InitValue::kUnknown;
   p.sensor.odd_occ = hits ? 1.0 : 0.0;
   p.sensor.odd_emp = hits ? 0.0 : 1.0;
   return p;
 }
 
-MapParams reflectionParams(PolicyType type, double res, int levels) {
+MapParams reflectionParams(PolicyType type, double res, int levels,
+                           wavog::InitValue init = wavog::InitValue::kUnknown) {
   MapParams p = MapParams::defaultsFor(type);
+  p.policy.init = init;
   p.grid.resolution = res;
   p.grid.block_levels = levels;
   p.reflection = true;
   return p;
 }
 
-// p of the reference from its hits (layer 0) and misses (layer 1) over scale-s block (bx, by).
-double referenceP(DenseReference* ref, bool hits_only, int s, std::int64_t bx, std::int64_t by) {
+// p of the reference from its hits (layer 0) and misses (layer 1) over scale-s block (bx, by),
+// and the tolerance of the tree's: kTolerance, plus, where the misses are read from the occupancy
+// ("none", "forget"), the occupancy's own tolerance carried through m = (L - prior - odd_occ h) /
+// odd_emp: kTolerance times the largest |L| of the block's cells (at least 1; |L| <= |prior| +
+// odd_occ h + |odd_emp| m, hundreds under "none"), over |odd_emp| and the block's mean count.
+double referenceP(DenseReference* ref, const MapParams& p, bool hits_only, int s, std::int64_t bx,
+                  std::int64_t by, double* tolerance) {
+  *tolerance = kTolerance;
   if (!ref->blockAnyKnown(s, bx, by)) return std::numeric_limits<double>::quiet_NaN();
   ref->selectLayer(0);
   const double h = ref->blockMean(s, bx, by);
   if (hits_only) return h > 0.0 ? 1.0 : 0.0;
   ref->selectLayer(1);
   const double m = ref->blockMean(s, bx, by);
+  if (p.policy.type != PolicyType::kNone && p.policy.type != PolicyType::kForget) return h / (h + m);
+  double largest = 1.0;
+  const std::int64_t size = std::int64_t{1} << s;
+  for (std::int64_t y = by * size; y < (by + 1) * size; ++y) {
+    for (std::int64_t x = bx * size; x < (bx + 1) * size; ++x) {
+      ref->selectLayer(0);
+      const double hc = ref->value(x, y);
+      ref->selectLayer(1);
+      const double mc = ref->value(x, y);
+      largest = std::max(largest, std::fabs(p.initValue()) + p.sensor.odd_occ * hc -
+                                      p.sensor.odd_emp * mc);
+    }
+  }
+  *tolerance += kTolerance * largest / (-p.sensor.odd_emp * (h + m));
   return h / (h + m);
 }
 
@@ -60,6 +85,7 @@ double referenceP(DenseReference* ref, bool hits_only, int s, std::int64_t bx, s
 // both sides where nothing was observed).
 void expectSameReflection(const WaveletMap& map, DenseReference* ref, bool hits_only, int max_scale,
                           const std::string& what) {
+  const MapParams& params = map.params();
   const CellBox& e = ref->extent();
   for (int s = 0; s <= max_scale; ++s) {
     const CellBox box{-((-e.min_x) >> s), -((-e.min_y) >> s), e.max_x >> s, e.max_y >> s};
@@ -70,17 +96,19 @@ void expectSameReflection(const WaveletMap& map, DenseReference* ref, bool hits_
     for (std::int64_t by = box.min_y; by < box.max_y; ++by) {
       for (std::int64_t bx = box.min_x; bx < box.max_x; ++bx) {
         const auto k = static_cast<std::size_t>((by - box.min_y) * box.width() + (bx - box.min_x));
-        const double want = referenceP(ref, hits_only, s, bx, by);
+        double tolerance = kTolerance;
+        const double want = referenceP(ref, params, hits_only, s, bx, by, &tolerance);
         if (std::isnan(want) != std::isnan(r.p[k])) {
           ++known_bad;
           continue;
         }
         if (std::isnan(want)) continue;
         ++observed;
-        worst = std::max(worst, std::fabs(r.p[k] - want));
+        // Errors in units of the cell's tolerance: the worst must stay within 1.
+        worst = std::max(worst, std::fabs(r.p[k] - want) * kTolerance / tolerance);
         if (s == 0) {
           const float point = map.reflection({bx, by});
-          worst = std::max(worst, std::fabs(point - want));
+          worst = std::max(worst, std::fabs(point - want) * kTolerance / tolerance);
         }
       }
     }
@@ -111,12 +139,67 @@ TEST(Reflection, RandomScansEveryPolicyEveryScale) {
   const auto cells = static_cast<std::int64_t>(std::ceil(half / res));
   for (int levels : {3, 5}) {
     for (PolicyType type : everyPolicyType()) {
-      const std::string name = std::string(wavog::toString(type)) + " L" + std::to_string(levels);
+      for (wavog::InitValue init : {wavog::InitValue::kUnknown, wavog::InitValue::kEmptyBound}) {
+      const std::string name = std::string(wavog::toString(type)) + " L" + std::to_string(levels) +
+                               " " + wavog::toString(init);
       SCOPED_TRACE(name);
-      ReflectionRun run(reflectionParams(type, res, levels), CellBox{-cells, -cells, cells, cells});
+      ReflectionRun run(reflectionParams(type, res, levels, init),
+                        CellBox{-cells, -cells, cells, cells});
       RandomScans scans(31337u + static_cast<unsigned>(levels), half);
       for (int i = 0; i < 200; ++i) run.integrate(scans.next());
       expectSameReflection(run.map, &run.ref, run.hits_only, levels, name);
+      }
+    }
+  }
+}
+
+// A change of policy, odd values or prior restarts the reflection map (from no counts, in a mode
+// that does not read the occupancy, whose history is another policy's): from then on it equals a
+// reference started at the change.
+TEST(Reflection, PolicyChangesRestartItExactly) {
+  const double res = 0.1, half = 12.0;
+  const auto cells = static_cast<std::int64_t>(std::ceil(half / res));
+  const CellBox extent{-cells, -cells, cells, cells};
+  const std::vector<std::pair<PolicyType, PolicyType>> changes = {
+      {PolicyType::kClamp, PolicyType::kForget},
+      {PolicyType::kForget, PolicyType::kNone},
+      {PolicyType::kNone, PolicyType::kClamp},
+      {PolicyType::kForget, PolicyType::kForget}};  // the same policy, another odd_occ
+  for (const auto& change : changes) {
+    const std::string name =
+        std::string(wavog::toString(change.first)) + " -> " + wavog::toString(change.second);
+    SCOPED_TRACE(name);
+    WaveletMap map(reflectionParams(change.first, res, 4));
+    RandomScans scans(99u, half);
+    for (int i = 0; i < 60; ++i) {
+      const OwnedScan s = scans.next();
+      map.integrate(s.pose, s.view());
+    }
+    MapParams after = reflectionParams(change.second, res, 4);
+    if (change.first == change.second) after.sensor.odd_occ += 0.25;
+    map.setPolicy(after.policy, after.sensor);
+    // Restarted: no count anywhere (NaN, or 0 where the occupancy's knowledge remains).
+    for (float v : map.exportReflection(0, extent).p) ASSERT_TRUE(std::isnan(v) || v == 0.0f);
+    ReflectionRun run(after, extent);
+    for (int i = 0; i < 120; ++i) {
+      const OwnedScan s = scans.next();
+      map.integrate(s.pose, s.view());
+      run.ref.integrate(s.pose, s.view());
+    }
+    expectSameReflection(map, &run.ref, false, 4, name);
+    // A gamma change keeps it: only the rate of the following scans changes.
+    if (change.second == PolicyType::kForget) {
+      wavog::PolicyParams slower = after.policy;
+      slower.gamma = 0.1;
+      map.setPolicy(slower, after.sensor);
+      run.ref.setGamma(0, 0.1);
+      run.ref.setGamma(1, 0.1);
+      for (int i = 0; i < 40; ++i) {
+        const OwnedScan s = scans.next();
+        map.integrate(s.pose, s.view());
+        run.ref.integrate(s.pose, s.view());
+      }
+      expectSameReflection(map, &run.ref, false, 4, name + ", gamma 0.1");
     }
   }
 }
@@ -190,10 +273,12 @@ TEST(Reflection, FilesClearingResetAndPolicyChanges) {
   loaded.reset();
   const auto empty = loaded.exportReflection(0, box);
   for (float v : empty.p) ASSERT_TRUE(std::isnan(v));
-  // forget -> max keeps the hits and drops the misses (p reads 1 where a beam ended, else 0).
+  // forget -> max restarts from no hits; then p reads 1 where a beam ended, else 0.
   wavog::PolicyParams max_policy = p.policy;
   max_policy.type = PolicyType::kMax;
   map.setPolicy(max_policy, p.sensor);
+  for (float v : map.exportReflection(0, box).p) ASSERT_TRUE(std::isnan(v) || v == 0.0f);
+  integrateScans(&scans, 20, map);
   const auto hits_only = map.exportReflection(0, box);
   std::size_t ones = 0, zeros = 0;
   for (float v : hits_only.p) {
@@ -203,6 +288,74 @@ TEST(Reflection, FilesClearingResetAndPolicyChanges) {
   }
   EXPECT_GT(ones, 0u);
   EXPECT_GT(zeros, 0u);
+  std::remove(path.c_str());
+}
+
+// Every way the reflection map is kept (misses from the occupancy under "none" and "forget", h
+// from it alone under "forget" with the empty_bound prior, counted misses under the clamps, hits
+// only under "max", two layers after a restart) survives a round trip bit for bit; a map of
+// another basis (odd values) restarts it on loading, as a policy change would.
+TEST(Reflection, FilesKeepEveryModeAndRestartOnAnotherBasis) {
+  const std::string path = ::testing::TempDir() + "reflection_modes_" + std::to_string(::getpid());
+  struct Case {
+    PolicyType type;
+    wavog::InitValue init;
+    bool restarted;
+  };
+  const std::vector<Case> cases = {{PolicyType::kNone, wavog::InitValue::kUnknown, false},
+                                   {PolicyType::kForget, wavog::InitValue::kUnknown, false},
+                                   {PolicyType::kForget, wavog::InitValue::kEmptyBound, false},
+                                   {PolicyType::kClamp, wavog::InitValue::kUnknown, false},
+                                   {PolicyType::kMax, wavog::InitValue::kUnknown, false},
+                                   {PolicyType::kForget, wavog::InitValue::kUnknown, true},
+                                   {PolicyType::kNone, wavog::InitValue::kUnknown, true}};
+  const CellBox box{-60, -60, 60, 60};
+  for (const Case& c : cases) {
+    const std::string name = std::string(wavog::toString(c.type)) + " " +
+                             wavog::toString(c.init) + (c.restarted ? " restarted" : "");
+    SCOPED_TRACE(name);
+    MapParams p = reflectionParams(c.type, 0.1, 5, c.init);
+    WaveletMap map(p);
+    RandomScans scans(123u, 6.0);
+    if (c.restarted) {
+      MapParams before = reflectionParams(PolicyType::kClamp, 0.1, 5);
+      map.setPolicy(before.policy, before.sensor);
+      integrateScans(&scans, 30, map);
+      map.setPolicy(p.policy, p.sensor);
+    }
+    integrateScans(&scans, 60, map);
+    map.save(path);
+    WaveletMap loaded(p);
+    loaded.load(path);
+    const auto before = map.exportReflection(2, box), after = loaded.exportReflection(2, box);
+    const auto cells_before = map.exportReflection(0, box), cells_after = loaded.exportReflection(0, box);
+    std::size_t known = 0;
+    for (std::size_t i = 0; i < cells_before.p.size(); ++i) {
+      ASSERT_TRUE((std::isnan(cells_before.p[i]) && std::isnan(cells_after.p[i])) ||
+                  cells_before.p[i] == cells_after.p[i])
+          << i;
+      known += std::isnan(cells_before.p[i]) ? 0 : 1;
+    }
+    for (std::size_t i = 0; i < before.p.size(); ++i) {
+      ASSERT_TRUE((std::isnan(before.p[i]) && std::isnan(after.p[i])) || before.p[i] == after.p[i]);
+    }
+    EXPECT_GT(known, 100u);
+    EXPECT_LE(loaded.stats().reflection_bytes, map.stats().reflection_bytes);  // tight vectors
+    EXPECT_GE(2 * loaded.stats().reflection_bytes, map.stats().reflection_bytes);
+    // Both go on the same way.
+    integrateScans(&scans, 10, map, loaded);
+    const auto go_on = map.exportReflection(0, box), go_on_loaded = loaded.exportReflection(0, box);
+    for (std::size_t i = 0; i < go_on.p.size(); ++i) {
+      ASSERT_TRUE((std::isnan(go_on.p[i]) && std::isnan(go_on_loaded.p[i])) ||
+                  go_on.p[i] == go_on_loaded.p[i]);
+    }
+    // Another odd_occ: the file's counts do not hold under it, the reflection map restarts.
+    MapParams other = p;
+    other.sensor.odd_occ += 0.25;
+    WaveletMap elsewhere(other);
+    elsewhere.load(path);
+    for (float v : elsewhere.exportReflection(0, box).p) ASSERT_TRUE(std::isnan(v) || v == 0.0f);
+  }
   std::remove(path.c_str());
 }
 

@@ -1,0 +1,85 @@
+// The hits of the reflection map (MapParams::reflection, reflection.cpp), kept per block for the
+// finest cells a beam ended in (the occupied band) and nowhere else: a count of hits under the
+// counting policies, and under "forget" the ratio q = A / h of the cell's weight of never having
+// been observed (A, the product of its (1 - g) factors) to its hits h. Between two hits both
+// decay by the same factors, so q stays as it was and free space is never touched: h is read back
+// from the occupancy (reflection.cpp). Not installed; included only by src/core/*.
+#ifndef WAVOG_MAPPING_SRC_CORE_REFLECTION_STORE_H_
+#define WAVOG_MAPPING_SRC_CORE_REFLECTION_STORE_H_
+
+#include <algorithm>
+#include <cstdint>
+
+#include "cell_runs.h"
+#include "wavog_mapping/core/params.h"
+
+namespace wavog {
+namespace detail {
+
+/// The hits of one cell under a counting policy (none, max, the clamps); 0 is no entry.
+struct HitCount {
+  std::uint32_t code = 0;
+  std::uint32_t n = 0;
+
+  bool live() const { return n != 0; }
+  void kill() { n = 0; }
+};
+
+/// The hits of one cell under "forget": q = A / h >= 0; negative is no entry.
+struct HitRatio {
+  std::uint32_t code = 0;
+  float q = -1.0f;
+
+  bool live() const { return q >= 0.0f; }
+  void kill() { q = -1.0f; }
+};
+
+/// A block's hits: `counts` or `ratios`, by the map's policy. `scans`: integrations that met the
+/// block since its ratios were last swept of the cells whose hits have faded (reflection.cpp).
+struct HitCells {
+  CellRuns<HitCount> counts;
+  CellRuns<HitRatio> ratios;
+  std::uint32_t scans = 0;
+
+  bool empty() const { return counts.empty() && ratios.empty(); }
+};
+
+/// Hits under "forget" below which a cell's ratio is dropped (its h reads 0 from then on).
+constexpr double kFadedHits = 1e-7;
+
+/// What the occupancy of a cell says about its hits h and misses m when the map has applied one
+/// policy with the same odd values and prior since it was empty (ALGORITHM.md; docs/algorithm.md):
+/// "none" gives L = init + odd_occ h + odd_emp m, "forget" (prior 0) L = odd_occ h + odd_emp m with
+/// h + m = 1 - A, A the cell's weight of never having been observed.
+struct ReflectionBasis {
+  PolicyType type = PolicyType::kNone;
+  double odd_occ = 0.0, odd_emp = 0.0, init = 0.0;
+
+  bool operator==(const ReflectionBasis& o) const {
+    return type == o.type && odd_occ == o.odd_occ && odd_emp == o.odd_emp && init == o.init;
+  }
+  bool operator!=(const ReflectionBasis& o) const { return !(*this == o); }
+  /// The misses of a cell (or the mean of a square's cells) of log-odds `l` and hits `h`.
+  double misses(double l, double h) const { return (l - init - odd_occ * h) / odd_emp; }
+  /// "forget": the hits of a cell of log-odds `l` and ratio q = A / h (solving the above).
+  double hitsFromRatio(double l, float q) const {
+    const double h = (l - odd_emp) / ((odd_occ - odd_emp) - odd_emp * static_cast<double>(q));
+    return std::min(1.0, std::max(0.0, h));
+  }
+  /// "forget": A of a cell of log-odds `l` that was never hit (h = 0, m = 1 - A).
+  double neverObservedWeight(double l) const {
+    return std::min(1.0, std::max(0.0, 1.0 - l / odd_emp));
+  }
+};
+
+/// One occupied (O) finest cell of a scan, as the quadtree walk met it: its Morton code within
+/// its block and its log-odds before the scan.
+struct HitObservation {
+  std::uint32_t code;
+  double before;
+};
+
+}  // namespace detail
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_SRC_CORE_REFLECTION_STORE_H_
