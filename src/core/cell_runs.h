@@ -49,10 +49,53 @@ struct CellRuns {
     }
     return *entries.insert(pos, fresh);
   }
-  /// Merges the tail into the first run when it is longer than 2 sqrt(sorted) and kTail.
+  /// For items [first, last) ascending by `code` (one per cell): update(entry, item) on the entry
+  /// of each item's cell, live or dead (it must leave it live), or, when it has none, a new
+  /// entry make(item) (live); new entries join the tail as one sorted batch.
+  template <typename Item, typename Update, typename Make>
+  void upsertSorted(const Item* first, const Item* last, Update update, Make make) {
+    const std::size_t old_size = entries.size();
+    const auto items = static_cast<std::size_t>(last - first);
+    if (old_size + items > entries.capacity()) {
+      // Room for every item (no pointer moves below); grown by a quarter, not the usual double,
+      // so that at most 25 % of the bytes (and the last call's items) go unused.
+      entries.reserve(old_size + items + old_size / 4 + kTail);
+    }
+    Entry* const run_end = entries.data() + sorted;
+    Entry* const tail_end = entries.data() + old_size;
+    // The items ascend: each search goes on from where the last one ended, in both runs; new
+    // entries go after the tail, ascending too.
+    Entry* in_run = entries.data();
+    Entry* in_tail = run_end;
+    for (const Item* it = first; it != last; ++it) {
+      in_run = gallop(in_run, run_end, it->code);
+      Entry* e = in_run != run_end && in_run->code == it->code ? in_run : nullptr;
+      if (e == nullptr) {
+        in_tail = gallop(in_tail, tail_end, it->code);
+        if (in_tail != tail_end && in_tail->code == it->code) e = in_tail;
+      }
+      if (e == nullptr) {
+        entries.push_back(make(*it));
+        continue;
+      }
+      if (!e->live()) --dead;
+      update(*e, *it);
+    }
+    added_ = entries.size() - old_size;
+    if (added_ == 0) return;
+    const auto by_code = [](const Entry& a, const Entry& b) { return a.code < b.code; };
+    std::inplace_merge(entries.begin() + static_cast<std::ptrdiff_t>(sorted),
+                       entries.begin() + static_cast<std::ptrdiff_t>(old_size), entries.end(),
+                       by_code);
+  }
+  /// Merges the tail into the first run when it is longer than kTail and 2 sqrt(sorted k), k the
+  /// entries the last upsertSorted() added (1 for single inserts): with k new entries at a time,
+  /// that balances the merges' moves (sorted k / tail) against the tail's (tail).
   void mergeTailIfLong() {
     const std::size_t tail = entries.size() - sorted;
-    if (tail <= kTail || tail * tail <= 4 * sorted) return;
+    const std::size_t k = std::max<std::size_t>(1, added_);
+    added_ = 0;
+    if (tail <= kTail || tail * tail <= 4 * sorted * k) return;
     const auto by_code = [](const Entry& a, const Entry& b) { return a.code < b.code; };
     std::inplace_merge(entries.begin(), entries.begin() + static_cast<std::ptrdiff_t>(sorted),
                        entries.end(), by_code);
@@ -86,11 +129,33 @@ struct CellRuns {
   static constexpr std::size_t kTail = 32;
 
  private:
-  static Entry* findIn(Entry* b, Entry* e, std::uint32_t code) {
+  std::size_t added_ = 0;  // entries the last upsertSorted() added
+
+  // The first entry of [b, e) (ascending) whose code is not below `code`: steps of 1, 2, 4, ...
+  // from b, then a binary search in the last one.
+  static Entry* gallop(Entry* b, Entry* e, std::uint32_t code) {
+    std::size_t step = 1;
+    Entry* lo = b;
+    while (lo != e && lo->code < code) {
+      const auto left = static_cast<std::size_t>(e - lo);
+      Entry* hi = lo + std::min(step, left);
+      if (hi == e || hi->code >= code) {
+        return std::lower_bound(lo, hi, code,
+                                [](const Entry& x, std::uint32_t c) { return x.code < c; });
+      }
+      lo = hi;
+      step *= 2;
+    }
+    return lo;
+  }
+  // The entry of `code` in [b, e), or nullptr; `at`: where it is or would be.
+  static Entry* findIn(Entry* b, Entry* e, std::uint32_t code, Entry** at = nullptr) {
     Entry* it =
         std::lower_bound(b, e, code, [](const Entry& x, std::uint32_t c) { return x.code < c; });
+    if (at != nullptr) *at = it;
     return it != e && it->code == code ? it : nullptr;
   }
+
 };
 
 /// Morton code of the cell at (lx, ly) within its block: x in the even bits, y in the odd ones,

@@ -35,11 +35,12 @@ struct HitRatio {
 };
 
 /// A block's hits: `counts` or `ratios`, by the map's policy. `scans`: integrations that met the
-/// block since its ratios were last swept of the cells whose hits have faded (reflection.cpp).
+/// block since its ratios were last swept of the cells whose hits have faded; `quiet`: the last
+/// of them in a row without a hit (reflection_update.h).
 struct HitCells {
   CellRuns<HitCount> counts;
   CellRuns<HitRatio> ratios;
-  std::uint32_t scans = 0;
+  std::uint32_t scans = 0, quiet = 0;
 
   bool empty() const { return counts.empty() && ratios.empty(); }
 };

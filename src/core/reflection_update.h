@@ -38,41 +38,64 @@ class HitBlockUpdate {
     if (obs_.empty() && !b.hits) return;
     if (!b.hits) b.hits = std::make_unique<HitCells>();
     HitCells& cells = *b.hits;
+    // The walk lists the cells in Morton order already (children in q order).
+    const auto by_code = [](const HitObservation& x, const HitObservation& y) {
+      return x.code < y.code;
+    };
+    if (!std::is_sorted(obs_.begin(), obs_.end(), by_code)) {
+      std::sort(obs_.begin(), obs_.end(), by_code);
+    }
+    const HitObservation* first = obs_.data();
+    const HitObservation* last = first + obs_.size();
     if (c_.ratios) {
-      for (const HitObservation& o : obs_) renew(&cells.ratios, o);
+      cells.ratios.upsertSorted(
+          first, last, [this](HitRatio& e, const HitObservation& o) { renew(&e, o); },
+          [this](const HitObservation& o) {
+            HitRatio e;
+            e.code = o.code;
+            renew(&e, o);
+            return e;
+          });
       cells.ratios.mergeTailIfLong();
-      if (++cells.scans >= kSweepScans) {
+      // Sweep now and then, and soon when the block's hits stop (its cells then fade fast).
+      cells.quiet = obs_.empty() ? cells.quiet + 1 : 0;
+      if (++cells.scans >= kSweepScans || cells.quiet == kQuietScans) {
         cells.scans = 0;
         sweep(&cells.ratios, ix0, iy0);
       }
     } else {
-      for (const HitObservation& o : obs_) {
-        HitCount& e = cells.counts.findOrInsert(o.code);
-        if (!e.live()) --cells.counts.dead;
-        if (e.n != std::numeric_limits<std::uint32_t>::max()) ++e.n;
-      }
+      cells.counts.upsertSorted(
+          first, last,
+          [](HitCount& e, const HitObservation&) {
+            if (e.n != std::numeric_limits<std::uint32_t>::max()) ++e.n;
+          },
+          [](const HitObservation& o) {
+            HitCount e;
+            e.code = o.code;
+            e.n = 1;
+            return e;
+          });
       cells.counts.mergeTailIfLong();
     }
     obs_.clear();
   }
 
-  /// Integrations of a block between two sweeps of its faded ratios.
-  static constexpr std::uint32_t kSweepScans = 64;
+  /// Integrations of a block between two sweeps of its faded ratios, and integrations in a row
+  /// without a hit after which it is swept.
+  static constexpr std::uint32_t kSweepScans = 1024, kQuietScans = 64;
 
  private:
-  // A hit on the cell of `o`: h <- a h + g, A <- a A, q = A / h.
-  void renew(CellRuns<HitRatio>* runs, const HitObservation& o) {
-    HitRatio& e = runs->findOrInsert(o.code);
+  // A hit on the cell of `o` (entry e, live or not): h <- a h + g, A <- a A, q = A / h.
+  void renew(HitRatio* e, const HitObservation& o) const {
     double h = 0.0, never = 0.0;
-    if (e.live()) {
-      h = c_.basis.hitsFromRatio(o.before, e.q);
-      never = static_cast<double>(e.q) * h;
+    if (e->live()) {
+      h = c_.basis.hitsFromRatio(o.before, e->q);
+      never = static_cast<double>(e->q) * h;
     } else {
-      --runs->dead;
       never = c_.basis.neverObservedWeight(o.before);
     }
     h = c_.a * h + c_.g;
-    e.q = static_cast<float>(std::min(1.0, c_.a * never) / h);
+    e->q = static_cast<float>(std::min(1.0, c_.a * never) / h);
   }
 
   // Drops the ratios of cells whose hits have faded below kFadedHits.

@@ -205,6 +205,15 @@ std::vector<std::string> MappingRos::Impl::onReconfigure(const wavog_mapping::Ma
       ROS_INFO("%s: policy %s, init %s from now on", pnh_.getNamespace().c_str(),
                wavog::toString(next.map.policy.type), wavog::toString(next.map.policy.init));
     }
+    if (config_.map.reflection &&
+        (next.map.policy.type != config_.map.policy.type ||
+         next.map.initValue() != config_.map.initValue() ||
+         next.map.sensor.odd_occ != config_.map.sensor.odd_occ ||
+         next.map.sensor.odd_emp != config_.map.sensor.odd_emp)) {
+      ROS_INFO("%s: the reflection map restarts from no hits and misses (policy, prior or odd "
+               "values changed)",
+               pnh_.getNamespace().c_str());
+    }
     if (next.ros.publish_rate != config_.ros.publish_rate) new_period = 1.0 / next.ros.publish_rate;
     // Only the run-time fields: the others (frames, ...) are read without the lock.
     config_.map = next.map;
