@@ -4,10 +4,11 @@
 // (resolution onwards), framed with the magic, version and a valid CRC-32, so that mutations
 // reach the parser behind the checksum; clear: the rest is the file as it is. Bits 1-2: the
 // loading map's policy (clamp, or forgetting with one of three gammas, so a file's pending
-// forgetting tags are sometimes applied while loading). Bit 3: the framed version is 1 (u8
-// pending counts) instead of 3. Bit 4: forgetting with forget_half_life (16-bit pending units).
-// Bit 5: the loading map keeps normal-distribution cells (MapParams::ndt); with bit 6 and not
-// bit 3 the framed version is 2 (no NDT section).
+// forgetting tags are sometimes applied while loading). Bits 3 and 6: the framed version, 4
+// (neither), 1 (bit 3: u8 pending counts), 2 (bit 6: no NDT section) or 3 (both: no hits
+// section). Bit 4: forgetting with forget_half_life (16-bit pending units). Bit 5: the loading
+// map keeps normal-distribution cells (MapParams::ndt). Bit 7: it keeps a reflection map
+// (MapParams::reflection).
 #include <zlib.h>
 
 #include <cmath>
@@ -38,6 +39,11 @@ std::vector<std::uint8_t> frame(const std::uint8_t* body, std::size_t size, std:
   return out;
 }
 
+std::uint32_t framedVersion(std::uint8_t mode) {
+  const bool b3 = (mode & 8) != 0, b6 = (mode & 64) != 0;
+  return b3 ? (b6 ? 3 : 1) : (b6 ? 2 : 4);
+}
+
 // Parameters the file can be loaded with: its own resolution and block_levels when they are
 // valid (otherwise the load is refused at once, which is tested as well).
 MapParams paramsFor(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
@@ -48,6 +54,7 @@ MapParams paramsFor(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
   p.policy.gamma = kGamma[policy];
   if (policy != 0 && (mode & 16)) p.policy.forget_half_life = 0.3;
   p.ndt = (mode & 32) != 0;
+  p.reflection = (mode & 128) != 0;
   if (file.size() >= 24) {
     MapParams q = p;
     std::memcpy(&q.grid.resolution, file.data() + 12, sizeof(double));
@@ -65,7 +72,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t mode = data[0];
   const std::vector<std::uint8_t> file = (mode & 1)
-                                             ? frame(data + 1, size - 1, (mode & 8) ? 1 : (mode & 64) ? 2 : 3)
+                                             ? frame(data + 1, size - 1, framedVersion(mode))
                                              : std::vector<std::uint8_t>(data + 1, data + size);
   const MapParams params = paramsFor(file, mode);
   static const std::string path = wavog_fuzz::scratchPath("load.wavog");
