@@ -1,7 +1,7 @@
 // The storage of normal-distribution cells (MapParams::ndt): each block keeps the Gaussians of its
-// finest cells as moments in a vector, most of it sorted by the cells' Morton codes within the
-// block (so the cells under any quadtree node are one contiguous run of each of its two sorted
-// runs), the latest new cells in a short second run that is merged in when it grows. Moments are
+// finest cells as moments in the block's sorted runs of cells (cell_runs.h: most sorted by the
+// cells' Morton codes within the block, so the cells under any quadtree node are one contiguous
+// run of each of its two sorted runs, the latest new cells in a short second run). Moments are
 // sums of weighted end-points in coordinates relative to the cell's centre, in double: a cell's
 // covariance comes out without the cancellation of map-frame moments. Not installed; included only
 // by src/core/*.

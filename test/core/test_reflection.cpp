@@ -359,9 +359,9 @@ TEST(Reflection, FilesKeepEveryModeAndRestartOnAnotherBasis) {
   std::remove(path.c_str());
 }
 
-// Section 6.5 for the layers: a region seen empty long enough loses its detail in the hits and
-// misses trees too (their odd values are 0 and 1, in either order).
-TEST(Reflection, LongEmptyRunsCollapseTheLayersWithForgetting) {
+// Section 6.5 for the reflection map: a region seen empty long enough loses its hits too (their
+// entries are swept once the block has had no hit for a while), as the occupancy loses its detail.
+TEST(Reflection, LongEmptyRunsShrinkItWithForgetting) {
   MapParams p = reflectionParams(PolicyType::kForget, 0.1, 5);
   p.sensor.no_return_clear = 12.0;  // the empty scans below clear without hits
   WaveletMap map(p);
@@ -378,7 +378,7 @@ TEST(Reflection, LongEmptyRunsCollapseTheLayersWithForgetting) {
   empty.range_max = 40.0;
   empty.ranges.assign(2000, std::numeric_limits<float>::infinity());
   for (int i = 0; i < 120; ++i) map.integrate(empty.pose, empty.view());
-  // The two layers shrink as the occupancy tree does (which section 6.5 collapses).
+  // The hits shrink as the occupancy tree does (which section 6.5 collapses).
   const double layers_ratio = static_cast<double>(map.stats().reflection_bytes) / layers_before;
   const double main_ratio = static_cast<double>(occupancyBytes()) / main_before;
   EXPECT_LT(main_ratio, 0.5);

@@ -106,10 +106,13 @@ struct MapParams {
   /// Also keep a reflection probability map (paper section 1.2.2, eq. 1.3): per finest cell the
   /// beams that ended in it (hits, the occupied band) and that crossed it (misses, E cells), under
   /// the map's policy: "none" counts, "forget" forgets both by gamma (h <- (1-g) h + g [hit],
-  /// m <- (1-g) m + g [miss]), "max" counts hits only (the paper's compression), and the clamp
-  /// policies count unbounded (bounding hits and misses apart would bias p, paper section 1.3.3;
-  /// use "forget" for a bounded reflection map). Off by default: maps, speed and files are then
-  /// those without it.
+  /// m <- (1-g) m + g [miss], from h = m = 0, or m = 1 with the empty_bound prior, as the
+  /// occupancy starts at its empty bound), "max" counts hits only (the paper's compression), and
+  /// the clamp policies count unbounded (bounding hits and misses apart would bias p, paper
+  /// section 1.3.3; use "forget" for a bounded reflection map). Under "none" and "forget" the
+  /// misses are read from the occupancy, so only hit cells cost anything. A change of the policy,
+  /// its odd values or the prior (setPolicy, or a file built under other ones) restarts it from no
+  /// counts. Off by default: maps, speed and files are then those without it.
   bool reflection = false;
   /// Also keep normal-distribution cells (paper section 1.2.3, Biber's NDT): per finest cell the
   /// weight, mean and covariance of the beam end-points that fell in it, with the map's policy
