@@ -83,10 +83,19 @@ struct CellRuns {
     }
     added_ = entries.size() - old_size;
     if (added_ == 0) return;
-    const auto by_code = [](const Entry& a, const Entry& b) { return a.code < b.code; };
-    std::inplace_merge(entries.begin() + static_cast<std::ptrdiff_t>(sorted),
-                       entries.begin() + static_cast<std::ptrdiff_t>(old_size), entries.end(),
-                       by_code);
+    // The new entries into the tail, from the back: each entry moves once.
+    thread_local std::vector<Entry> added;  // reused from call to call
+    added.assign(entries.begin() + static_cast<std::ptrdiff_t>(old_size), entries.end());
+    Entry* out = entries.data() + entries.size();
+    Entry* t = entries.data() + old_size;  // one past the old tail's last entry
+    Entry* const t_begin = entries.data() + sorted;
+    for (std::size_t a = added.size(); a > 0;) {
+      if (t != t_begin && t[-1].code > added[a - 1].code) {
+        *--out = *--t;
+      } else {
+        *--out = added[--a];
+      }
+    }
   }
   /// Merges the tail into the first run when it is longer than kTail and 2 sqrt(sorted k), k the
   /// entries the last upsertSorted() added (1 for single inserts): with k new entries at a time,
