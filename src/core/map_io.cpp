@@ -4,8 +4,8 @@
 //   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
 //              [root subtree, pre-order: f32 dx dy dxy (stored) | u16 pending count k |
 //               u8 child_mask | u8 known_all | u8 known_any | children in q order]
-//   u8 reflection layers n (0, 1: hits, 2: hits and misses), each: f64 a | u64 block count |
-//   blocks as above
+//   u8 reflection layers, a mask (1: hits, 2: misses; before version 4 their count, hits first),
+//   each: f64 a | u64 block count | blocks as above
 //   u64 count of blocks with normal-distribution cells (MapParams::ndt), each: i32 bx | i32 by |
 //   u32 n | n cells ascending by Morton code within the block: u32 code | f64 w sx sy sxx sxy syy
 //   (moments about the cell's centre, ndt_store.h)
