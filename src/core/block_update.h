@@ -60,14 +60,14 @@ template <PolicyType P, bool kNdt, bool kHits = false>
 // The instantiations compiled apart from integrate.cpp (integrate_ndt.cpp,
 // integrate_reflection.cpp), so that they do not change how the compiler inlines the others:
 // WAVOG_UPDATE_BLOCKS(policy, kNdt, kHits) for each.
-#define WAVOG_UPDATE_BLOCKS_ALL                                   \
-  WAVOG_UPDATE_BLOCKS(PolicyType::kForget, true, false)           \
-  WAVOG_UPDATE_BLOCKS(PolicyType::kNone, false, true)             \
-  WAVOG_UPDATE_BLOCKS(PolicyType::kMax, false, true)              \
-  WAVOG_UPDATE_BLOCKS(PolicyType::kClamp, false, true)            \
-  WAVOG_UPDATE_BLOCKS(PolicyType::kForget, false, true)           \
-  WAVOG_UPDATE_BLOCKS(PolicyType::kClampLower, false, true)       \
-  WAVOG_UPDATE_BLOCKS(PolicyType::kClampUpper, false, true)       \
+#define WAVOG_UPDATE_BLOCKS_ALL                             \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kForget, true, false)     \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kNone, false, true)       \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kMax, false, true)        \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kClamp, false, true)      \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kForget, false, true)     \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kClampLower, false, true) \
+  WAVOG_UPDATE_BLOCKS(PolicyType::kClampUpper, false, true) \
   WAVOG_UPDATE_BLOCKS(PolicyType::kForget, true, true)
 
 }  // namespace detail

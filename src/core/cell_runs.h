@@ -12,10 +12,10 @@ namespace wavog {
 namespace detail {
 
 /// The entries of one block's finest cells that hold a payload (Entry: a u32 `code`, `live()`,
-/// `kill()`; a value-initialised Entry is dead): two runs ascending by code, entries [0, sorted) and the short
-/// tail after them that takes new cells (merged into the first run when it outgrows twice the
-/// square root of it, so a new cell costs amortised O(sqrt(n)) moves). A dropped entry stays, dead,
-/// until dead ones are a quarter of the entries.
+/// `kill()`; a value-initialised Entry is dead): two runs ascending by code, entries [0, sorted)
+/// and the short tail after them that takes new cells (merged into the first run when it outgrows
+/// twice the square root of it, or of sorted k for batches of k, so a new cell costs amortised
+/// O(sqrt(n)) moves). A dropped entry stays, dead, until dead ones are a quarter of the entries.
 template <typename Entry>
 struct CellRuns {
   std::vector<Entry> entries;
@@ -164,7 +164,6 @@ struct CellRuns {
     if (at != nullptr) *at = it;
     return it != e && it->code == code ? it : nullptr;
   }
-
 };
 
 /// Morton code of the cell at (lx, ly) within its block: x in the even bits, y in the odd ones,

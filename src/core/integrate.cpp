@@ -21,10 +21,10 @@ namespace detail {
 // The update with the Gaussians' forgetting is compiled in its own file (integrate_ndt.cpp), so
 // that it does not change how the compiler inlines the others.
 // So are the updates with the hits of the reflection map (integrate_reflection.cpp).
-#define WAVOG_UPDATE_BLOCKS(P, NDT, HITS)                                                       \
-  extern template std::uint64_t updateBlocks<P, NDT, HITS>(                                    \
-      WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&,               \
-      const NdtConsts*, const HitConsts*, const std::vector<BlockJob>&, std::atomic<std::size_t>*);
+#define WAVOG_UPDATE_BLOCKS(P, NDT, HITS)                                                          \
+  extern template std::uint64_t updateBlocks<P, NDT, HITS>(                                        \
+      WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&, const NdtConsts*, \
+      const HitConsts*, const std::vector<BlockJob>&, std::atomic<std::size_t>*);
 WAVOG_UPDATE_BLOCKS_ALL
 #undef WAVOG_UPDATE_BLOCKS
 }  // namespace detail

@@ -6,10 +6,10 @@
 namespace wavog {
 namespace detail {
 
-#define WAVOG_UPDATE_BLOCKS(P, NDT, HITS)                                                    \
-  template std::uint64_t updateBlocks<P, NDT, HITS>(                                        \
-      WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&,            \
-      const NdtConsts*, const HitConsts*, const std::vector<BlockJob>&, std::atomic<std::size_t>*);
+#define WAVOG_UPDATE_BLOCKS(P, NDT, HITS)                                                          \
+  template std::uint64_t updateBlocks<P, NDT, HITS>(                                               \
+      WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&, const NdtConsts*, \
+      const HitConsts*, const std::vector<BlockJob>&, std::atomic<std::size_t>*);
 WAVOG_UPDATE_BLOCKS(PolicyType::kNone, false, true)
 WAVOG_UPDATE_BLOCKS(PolicyType::kMax, false, true)
 WAVOG_UPDATE_BLOCKS(PolicyType::kClamp, false, true)

@@ -49,11 +49,11 @@ constexpr std::uint32_t kOldestVersion = 1;  // u8 pending counts
 constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
 constexpr std::size_t kCrcBytes = 4;
 constexpr std::size_t kMinBlockBytes = 4 + 4 + 8 + 1;  // bx, by, average, flags
-constexpr std::size_t kNdtBlockBytes = 4 + 4 + 4;         // bx, by, cell count
-constexpr std::size_t kNdtCellBytes = 4 + 6 * 8;          // code, moments
-constexpr double kMaxNdtWeight = 1e15;  // end-points of one cell a file may claim
-constexpr std::size_t kHitBlockBytes = 4 + 4 + 1 + 4;     // bx, by, kind, cell count
-constexpr std::size_t kHitCellBytes = 4 + 4;              // code, count or ratio
+constexpr std::size_t kNdtBlockBytes = 4 + 4 + 4;      // bx, by, cell count
+constexpr std::size_t kNdtCellBytes = 4 + 6 * 8;       // code, moments
+constexpr double kMaxNdtWeight = 1e15;                 // end-points of one cell a file may claim
+constexpr std::size_t kHitBlockBytes = 4 + 4 + 1 + 4;  // bx, by, kind, cell count
+constexpr std::size_t kHitCellBytes = 4 + 4;           // code, count or ratio
 constexpr std::size_t kReflectionHeadBytes = 1 + 1 + 3 * 8 + 8;
 // Three details, k, mask, known bits.
 std::size_t nodeBytes(std::uint32_t version) { return 3 * 4 + (version == 1 ? 1 : 2) + 3; }
@@ -195,18 +195,18 @@ std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
                              (static_cast<double>(kMinBlockBytes) +
                               nodes_per_block * static_cast<double>(nodeBytes(version)));
   // Version 3 adds the Gaussians: at most every cell of every block.
-  const double ndt = version >= 3 ? 8.0 + static_cast<double>(count) *
-                                              (static_cast<double>(kNdtBlockBytes) +
-                                               std::ldexp(1.0, 2 * levels) *
-                                                   static_cast<double>(kNdtCellBytes))
-                                  : 0.0;
+  const double ndt =
+      version >= 3 ? 8.0 + static_cast<double>(count) *
+                               (static_cast<double>(kNdtBlockBytes) +
+                                std::ldexp(1.0, 2 * levels) * static_cast<double>(kNdtCellBytes))
+                   : 0.0;
   // Version 4 adds the hits: at most every cell of every block.
-  const double hits = version >= 4 ? static_cast<double>(kReflectionHeadBytes) +
-                                         static_cast<double>(count) *
-                                             (static_cast<double>(kHitBlockBytes) +
-                                              std::ldexp(1.0, 2 * levels) *
-                                                  static_cast<double>(kHitCellBytes))
-                                   : 0.0;
+  const double hits =
+      version >= 4 ? static_cast<double>(kReflectionHeadBytes) +
+                         static_cast<double>(count) *
+                             (static_cast<double>(kHitBlockBytes) +
+                              std::ldexp(1.0, 2 * levels) * static_cast<double>(kHitCellBytes))
+                   : 0.0;
   if (static_cast<double>(size) > largest + ndt + hits) {
     throw fail(std::to_string(size) + " bytes, more than its " + std::to_string(count) +
                " blocks can fill (at most " +
@@ -535,17 +535,16 @@ void WaveletMap::load(const std::string& path) {
       file = readReflection(fresh, impl_->params.reflection, data.size(), &r);
     } else if (file_layers[0]) {
       file.mode = ReflectionMode::kLayers;  // the hits and misses of older files
-      file.basis = fresh.currentBasis();  // not recorded; the layers count whatever it was
+      file.basis = fresh.currentBasis();    // not recorded; the layers count whatever it was
     }
     // The file's reflection map when it was built under this map's basis and holds the layers
     // its mode needs, else a restart.
     if (impl_->params.reflection) {
-      const bool needs_misses = impl_->params.policy.type != PolicyType::kMax &&
-                                (file.mode == ReflectionMode::kLayers ||
-                                 file.mode == ReflectionMode::kCounts);
-      const bool complete =
-          (file.mode != ReflectionMode::kLayers || file_layers[0] != nullptr) &&
-          (needs_misses ? file_layers[1] != nullptr : file_layers[1] == nullptr);
+      const bool needs_misses =
+          impl_->params.policy.type != PolicyType::kMax &&
+          (file.mode == ReflectionMode::kLayers || file.mode == ReflectionMode::kCounts);
+      const bool complete = (file.mode != ReflectionMode::kLayers || file_layers[0] != nullptr) &&
+                            (needs_misses ? file_layers[1] != nullptr : file_layers[1] == nullptr);
       if (file.mode != ReflectionMode::kOff && file.basis == fresh.currentBasis() && complete) {
         fresh.reflection_mode = file.mode;
         fresh.hits_layer = std::move(file_layers[0]);

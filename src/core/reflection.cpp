@@ -64,8 +64,9 @@ void WaveletMap::Impl::restartReflection(bool fresh) {
     layer->reset(new WaveletMap(layerParams(params, hits, reflection_mode), LayerTag{}));
   };
   if (reflection_mode == ReflectionMode::kLayers) make(&hits_layer, true);
-  const bool layer_misses = type != PolicyType::kMax && (reflection_mode == ReflectionMode::kLayers ||
-                                                         reflection_mode == ReflectionMode::kCounts);
+  const bool layer_misses =
+      type != PolicyType::kMax &&
+      (reflection_mode == ReflectionMode::kLayers || reflection_mode == ReflectionMode::kCounts);
   if (layer_misses) make(&misses_layer, false);
 }
 
@@ -119,7 +120,8 @@ void addHits(const WaveletMap::Impl& impl, const detail::CellRuns<Entry>& runs, 
     detail::mortonCell(e.code, &lx, &ly);
     const std::int64_t ix = x0 + lx, iy = y0 + ly;
     const std::int64_t rx = ix >> s, ry = iy >> s;
-    if (rx < window.min_x || rx >= window.max_x || ry < window.min_y || ry >= window.max_y) continue;
+    if (rx < window.min_x || rx >= window.max_x || ry < window.min_y || ry >= window.max_y)
+      continue;
     (*sums)[static_cast<std::size_t>((ry - window.min_y) * window.width() + (rx - window.min_x))] +=
         hitsOf(impl, e, ix, iy);
   }

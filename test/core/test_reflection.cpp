@@ -64,7 +64,8 @@ double referenceP(DenseReference* ref, const MapParams& p, bool hits_only, int s
   if (hits_only) return h > 0.0 ? 1.0 : 0.0;
   ref->selectLayer(1);
   const double m = ref->blockMean(s, bx, by);
-  if (p.policy.type != PolicyType::kNone && p.policy.type != PolicyType::kForget) return h / (h + m);
+  if (p.policy.type != PolicyType::kNone && p.policy.type != PolicyType::kForget)
+    return h / (h + m);
   double largest = 1.0;
   const std::int64_t size = std::int64_t{1} << s;
   for (std::int64_t y = by * size; y < (by + 1) * size; ++y) {
@@ -73,8 +74,8 @@ double referenceP(DenseReference* ref, const MapParams& p, bool hits_only, int s
       const double hc = ref->value(x, y);
       ref->selectLayer(1);
       const double mc = ref->value(x, y);
-      largest = std::max(largest, std::fabs(p.initValue()) + p.sensor.odd_occ * hc -
-                                      p.sensor.odd_emp * mc);
+      largest = std::max(largest,
+                         std::fabs(p.initValue()) + p.sensor.odd_occ * hc - p.sensor.odd_emp * mc);
     }
   }
   *tolerance += kTolerance * largest / (-p.sensor.odd_emp * (h + m));
@@ -140,14 +141,14 @@ TEST(Reflection, RandomScansEveryPolicyEveryScale) {
   for (int levels : {3, 5}) {
     for (PolicyType type : everyPolicyType()) {
       for (wavog::InitValue init : {wavog::InitValue::kUnknown, wavog::InitValue::kEmptyBound}) {
-      const std::string name = std::string(wavog::toString(type)) + " L" + std::to_string(levels) +
-                               " " + wavog::toString(init);
-      SCOPED_TRACE(name);
-      ReflectionRun run(reflectionParams(type, res, levels, init),
-                        CellBox{-cells, -cells, cells, cells});
-      RandomScans scans(31337u + static_cast<unsigned>(levels), half);
-      for (int i = 0; i < 200; ++i) run.integrate(scans.next());
-      expectSameReflection(run.map, &run.ref, run.hits_only, levels, name);
+        const std::string name = std::string(wavog::toString(type)) + " L" +
+                                 std::to_string(levels) + " " + wavog::toString(init);
+        SCOPED_TRACE(name);
+        ReflectionRun run(reflectionParams(type, res, levels, init),
+                          CellBox{-cells, -cells, cells, cells});
+        RandomScans scans(31337u + static_cast<unsigned>(levels), half);
+        for (int i = 0; i < 200; ++i) run.integrate(scans.next());
+        expectSameReflection(run.map, &run.ref, run.hits_only, levels, name);
       }
     }
   }
@@ -311,8 +312,8 @@ TEST(Reflection, FilesKeepEveryModeAndRestartOnAnotherBasis) {
                                    {PolicyType::kNone, wavog::InitValue::kUnknown, true}};
   const CellBox box{-60, -60, 60, 60};
   for (const Case& c : cases) {
-    const std::string name = std::string(wavog::toString(c.type)) + " " +
-                             wavog::toString(c.init) + (c.restarted ? " restarted" : "");
+    const std::string name = std::string(wavog::toString(c.type)) + " " + wavog::toString(c.init) +
+                             (c.restarted ? " restarted" : "");
     SCOPED_TRACE(name);
     MapParams p = reflectionParams(c.type, 0.1, 5, c.init);
     WaveletMap map(p);
@@ -328,7 +329,8 @@ TEST(Reflection, FilesKeepEveryModeAndRestartOnAnotherBasis) {
     WaveletMap loaded(p);
     loaded.load(path);
     const auto before = map.exportReflection(2, box), after = loaded.exportReflection(2, box);
-    const auto cells_before = map.exportReflection(0, box), cells_after = loaded.exportReflection(0, box);
+    const auto cells_before = map.exportReflection(0, box),
+               cells_after = loaded.exportReflection(0, box);
     std::size_t known = 0;
     for (std::size_t i = 0; i < cells_before.p.size(); ++i) {
       ASSERT_TRUE((std::isnan(cells_before.p[i]) && std::isnan(cells_after.p[i])) ||
