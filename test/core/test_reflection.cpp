@@ -206,11 +206,11 @@ TEST(Reflection, PolicyChangesRestartItExactly) {
 }
 
 TEST(Reflection, Fr079FirstScansEveryPolicy) {
-  const std::vector<OwnedScan> log = fr079Scans(300);
-  ASSERT_EQ(log.size(), 300u);
+  const std::vector<OwnedScan> log = fr079Scans(500);
+  ASSERT_EQ(log.size(), 500u);
   // The area of the first scans (fr079's first poses are near the origin, ranges < 50 m).
   const CellBox extent{-500, -500, 500, 500};
-  for (PolicyType type : {PolicyType::kNone, PolicyType::kMax, PolicyType::kForget}) {
+  for (PolicyType type : everyPolicyType()) {
     SCOPED_TRACE(wavog::toString(type));
     ReflectionRun run(reflectionParams(type, 0.1, 6), extent);
     for (const OwnedScan& s : log) run.integrate(s);
