@@ -41,13 +41,9 @@ struct CellRuns {
     ++dead;  // empty until its first payload is added
     Entry fresh{};
     fresh.code = code;
-    if (entries.size() == entries.capacity()) {
-      // Grow by a quarter (not the usual double): at most 25 % of the bytes go unused.
-      const auto at = pos - entries.begin();
-      entries.reserve(entries.size() + entries.size() / 4 + kTail);
-      return *entries.insert(entries.begin() + at, fresh);
-    }
-    return *entries.insert(pos, fresh);
+    const auto at = pos - entries.begin();
+    reserveFor(1);
+    return *entries.insert(entries.begin() + at, fresh);
   }
   /// For items [first, last) ascending by `code` (one per cell): update(entry, item) on the entry
   /// of each item's cell, live or dead (it must leave it live), or, when it has none, a new
@@ -56,11 +52,7 @@ struct CellRuns {
   void upsertSorted(const Item* first, const Item* last, Update update, Make make) {
     const std::size_t old_size = entries.size();
     const auto items = static_cast<std::size_t>(last - first);
-    if (old_size + items > entries.capacity()) {
-      // Room for every item (no pointer moves below); grown by a quarter, not the usual double,
-      // so that at most 25 % of the bytes (and the last call's items) go unused.
-      entries.reserve(old_size + items + old_size / 4 + kTail);
-    }
+    reserveFor(items);  // room for every item: no pointer below moves
     Entry* const run_end = entries.data() + sorted;
     Entry* const tail_end = entries.data() + old_size;
     // The items ascend: each search goes on from where the last one ended, in both runs; new
@@ -138,6 +130,13 @@ struct CellRuns {
   static constexpr std::size_t kTail = 32;
 
  private:
+  // Room for `extra` more entries, growing by a quarter (not the usual double) when there is none:
+  // at most 25 % of the bytes (and the last request's room) go unused.
+  void reserveFor(std::size_t extra) {
+    const std::size_t n = entries.size();
+    if (n + extra > entries.capacity()) entries.reserve(n + extra + n / 4 + kTail);
+  }
+
   std::size_t added_ = 0;  // entries the last upsertSorted() added
 
   // The first entry of [b, e) (ascending) whose code is not below `code`: steps of 1, 2, 4, ...

@@ -137,6 +137,11 @@ struct WaveletMap::Impl {
   /// After a policy change: restarts the reflection map if its basis changed (the counts of one
   /// policy mean something else under another), else re-parameterises its layers.
   void configureReflection();
+  /// After a load: the file's reflection map (its mode, basis and layers; its hits are in the
+  /// blocks already) when it was built under this map's basis and holds the layers its mode
+  /// needs, else a restart.
+  void adoptReflection(ReflectionMode mode, const detail::ReflectionBasis& basis,
+                       std::unique_ptr<WaveletMap> hits, std::unique_ptr<WaveletMap> misses);
   /// The parameters of reflection layer `hits` (else misses) of a map with `main` in `mode`.
   static MapParams layerParams(const MapParams& main, bool hits, ReflectionMode mode);
 

@@ -19,7 +19,8 @@
 // (before forget_half_life and reflection) also with a u8 pending count and no layers; all load.
 // Stored details and lazy counts are written as they are, so a round trip is bit-exact; a map
 // loaded under another factor applies the file's pending tags while loading.
-// Files are written and read through map_file.h (exclusive temporary + rename, regular files only).
+// Files are written and read through map_file.h (exclusive temporary + rename, regular files only);
+// the payload sections (Gaussians, hits) are map_payload_io.cpp's.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -29,9 +30,9 @@
 #include <memory>
 #include <sstream>
 #include <string>
-#include <type_traits>
 #include <vector>
 
+#include "map_codec.h"
 #include "map_file.h"
 #include "map_impl.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -41,6 +42,8 @@ namespace {
 
 using detail::Block;
 using detail::Node;
+using detail::Reader;
+using detail::Writer;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
 constexpr std::uint32_t kVersion = 4;
@@ -49,12 +52,6 @@ constexpr std::uint32_t kOldestVersion = 1;  // u8 pending counts
 constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
 constexpr std::size_t kCrcBytes = 4;
 constexpr std::size_t kMinBlockBytes = 4 + 4 + 8 + 1;  // bx, by, average, flags
-constexpr std::size_t kNdtBlockBytes = 4 + 4 + 4;      // bx, by, cell count
-constexpr std::size_t kNdtCellBytes = 4 + 6 * 8;       // code, moments
-constexpr double kMaxNdtWeight = 1e15;                 // end-points of one cell a file may claim
-constexpr std::size_t kHitBlockBytes = 4 + 4 + 1 + 4;  // bx, by, kind, cell count
-constexpr std::size_t kHitCellBytes = 4 + 4;           // code, count or ratio
-constexpr std::size_t kReflectionHeadBytes = 1 + 1 + 3 * 8 + 8;
 // Three details, k, mask, known bits.
 std::size_t nodeBytes(std::uint32_t version) { return 3 * 4 + (version == 1 ? 1 : 2) + 3; }
 
@@ -72,41 +69,6 @@ std::uint32_t crc32(const unsigned char* data, std::size_t size) {
   for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xFFu] ^ (c >> 8);
   return c ^ 0xFFFFFFFFu;
 }
-
-class Writer {
- public:
-  template <typename T>
-  void put(T v) {
-    bytes(&v, sizeof(T));
-  }
-  void bytes(const void* p, std::size_t n) {
-    const std::size_t at = buf_.size();
-    buf_.resize(at + n);
-    std::memcpy(buf_.data() + at, p, n);
-  }
-  std::vector<unsigned char>& buffer() { return buf_; }
-
- private:
-  std::vector<unsigned char> buf_;
-};
-
-class Reader {
- public:
-  Reader(const unsigned char* data, std::size_t size) : p_(data), end_(data + size) {}
-  template <typename T>
-  T get() {
-    if (static_cast<std::size_t>(end_ - p_) < sizeof(T)) throw std::out_of_range("truncated");
-    T v;
-    std::memcpy(&v, p_, sizeof(T));
-    p_ += sizeof(T);
-    return v;
-  }
-  bool done() const { return p_ == end_; }
-
- private:
-  const unsigned char* p_;
-  const unsigned char* end_;
-};
 
 void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
   for (float d : n.d) w->put(d);
@@ -194,23 +156,12 @@ std::vector<unsigned char> readMapFile(const std::string& path, int levels) {
                          maps * static_cast<double>(count) *
                              (static_cast<double>(kMinBlockBytes) +
                               nodes_per_block * static_cast<double>(nodeBytes(version)));
-  // Version 3 adds the Gaussians: at most every cell of every block.
-  const double ndt =
-      version >= 3 ? 8.0 + static_cast<double>(count) *
-                               (static_cast<double>(kNdtBlockBytes) +
-                                std::ldexp(1.0, 2 * levels) * static_cast<double>(kNdtCellBytes))
-                   : 0.0;
-  // Version 4 adds the hits: at most every cell of every block.
-  const double hits =
-      version >= 4 ? static_cast<double>(kReflectionHeadBytes) +
-                         static_cast<double>(count) *
-                             (static_cast<double>(kHitBlockBytes) +
-                              std::ldexp(1.0, 2 * levels) * static_cast<double>(kHitCellBytes))
-                   : 0.0;
-  if (static_cast<double>(size) > largest + ndt + hits) {
+  // Versions 3 and 4 add the Gaussians and the hits: at most every cell of every block.
+  const double payloads = detail::payloadSectionsBound(version, count, levels);
+  if (static_cast<double>(size) > largest + payloads) {
     throw fail(std::to_string(size) + " bytes, more than its " + std::to_string(count) +
                " blocks can fill (at most " +
-               std::to_string(static_cast<std::uint64_t>(largest + ndt + hits)) +
+               std::to_string(static_cast<std::uint64_t>(largest + payloads)) +
                " bytes at block_levels " + std::to_string(levels) + ")");
   }
   if (size > std::numeric_limits<std::size_t>::max()) throw fail("too large to read");
@@ -267,186 +218,6 @@ void readBlocks(WaveletMap::Impl& fresh, const PendingFormat& format, std::size_
   }
 }
 
-// The normal-distribution cells of the blocks that hold some, each block's in code order.
-void writeNdt(const WaveletMap::Impl& impl, Writer* w) {
-  std::uint64_t count = 0;
-  for (const auto& kv : impl.blocks) count += kv.second.ndt && !kv.second.ndt->empty() ? 1 : 0;
-  w->put(count);
-  std::vector<detail::NdtEntry> cells;
-  for (const auto& kv : impl.blocks) {
-    if (!kv.second.ndt || kv.second.ndt->empty()) continue;
-    cells.clear();
-    for (const detail::NdtEntry& e : kv.second.ndt->entries) {
-      if (detail::NdtCells::live(e)) cells.push_back(e);
-    }
-    std::sort(cells.begin(), cells.end(),
-              [](const detail::NdtEntry& a, const detail::NdtEntry& b) { return a.code < b.code; });
-    w->put(static_cast<std::int32_t>(detail::blockKeyX(kv.first)));
-    w->put(static_cast<std::int32_t>(detail::blockKeyY(kv.first)));
-    w->put(static_cast<std::uint32_t>(cells.size()));
-    for (const detail::NdtEntry& e : cells) {
-      w->put(e.code);
-      for (double v : {e.m.w, e.m.sx, e.m.sy, e.m.sxx, e.m.sxy, e.m.syy}) w->put(v);
-    }
-  }
-}
-
-// Reads the Gaussians into `fresh`'s blocks (read before); `keep`: false drops them (a map
-// without ndt).
-void readNdt(WaveletMap::Impl& fresh, bool keep, std::size_t bytes, Reader* r) {
-  const auto count = r->get<std::uint64_t>();
-  if (count > bytes / kNdtBlockBytes) throw std::runtime_error("bad NDT block count");
-  const std::uint64_t cells_per_block = std::uint64_t{1} << (2 * fresh.levels);
-  for (std::uint64_t i = 0; i < count; ++i) {
-    const auto bx = r->get<std::int32_t>();
-    const auto by = r->get<std::int32_t>();
-    const auto n = r->get<std::uint32_t>();
-    Block* b = fresh.findBlock(bx, by);
-    if (b == nullptr) throw std::runtime_error("NDT cells in a block the file does not hold");
-    if (n == 0 || n > cells_per_block || n > bytes / kNdtCellBytes) {
-      throw std::runtime_error("bad NDT cell count");
-    }
-    if (b->ndt) throw std::runtime_error("duplicate NDT block");
-    auto cells = std::make_unique<detail::NdtCells>();
-    cells->entries.resize(n);
-    for (std::uint32_t j = 0; j < n; ++j) {
-      detail::NdtEntry& e = cells->entries[j];
-      e.code = r->get<std::uint32_t>();
-      for (double* v : {&e.m.w, &e.m.sx, &e.m.sy, &e.m.sxx, &e.m.sxy, &e.m.syy}) {
-        *v = r->get<double>();
-        if (!std::isfinite(*v)) throw std::runtime_error("non-finite NDT moment");
-      }
-      if (e.code >= cells_per_block || (j > 0 && e.code <= cells->entries[j - 1].code)) {
-        throw std::runtime_error("NDT cells out of order");
-      }
-      // End-points lie in their cell: |offset| <= res / 2 (with round-off), weights are finite.
-      const double h = 0.5 * fresh.params.grid.resolution * (1.0 + 1e-9), w = e.m.w;
-      if (!(w > 0.0 && w <= kMaxNdtWeight) || std::fabs(e.m.sx) > w * h ||
-          std::fabs(e.m.sy) > w * h || !(e.m.sxx >= 0.0 && e.m.sxx <= w * h * h) ||
-          !(e.m.syy >= 0.0 && e.m.syy <= w * h * h) || std::fabs(e.m.sxy) > w * h * h) {
-        throw std::runtime_error("NDT cell with moments no end-points in the cell can have");
-      }
-    }
-    cells->sorted = n;
-    if (keep) b->ndt = std::move(cells);
-  }
-}
-
-// The hits of one block's cells: u8 kind, u32 n, the live entries in code order.
-template <typename Entry>
-void writeHitRuns(const detail::CellRuns<Entry>& runs, std::int64_t bx, std::int64_t by,
-                  std::uint8_t kind, Writer* w) {
-  std::vector<Entry> cells;
-  for (const Entry& e : runs.entries) {
-    if (e.live()) cells.push_back(e);
-  }
-  if (cells.empty()) return;
-  std::sort(cells.begin(), cells.end(),
-            [](const Entry& a, const Entry& b) { return a.code < b.code; });
-  w->put(static_cast<std::int32_t>(bx));
-  w->put(static_cast<std::int32_t>(by));
-  w->put(kind);
-  w->put(static_cast<std::uint32_t>(cells.size()));
-  for (const Entry& e : cells) {
-    w->put(e.code);
-    if constexpr (std::is_same_v<Entry, detail::HitCount>) {
-      w->put(e.n);
-    } else {
-      w->put(e.q);
-    }
-  }
-}
-
-// The reflection section (version 4): mode, basis and the hits of every block holding some.
-void writeReflection(const WaveletMap::Impl& impl, Writer* w) {
-  w->put(static_cast<std::uint8_t>(impl.reflection_mode));
-  const detail::ReflectionBasis& b = impl.reflection_basis;
-  w->put(static_cast<std::uint8_t>(b.type));
-  w->put(b.odd_occ);
-  w->put(b.odd_emp);
-  w->put(b.init);
-  std::uint64_t count = 0;
-  for (const auto& kv : impl.blocks) {
-    if (!kv.second.hits) continue;
-    count += kv.second.hits->counts.empty() ? 0 : 1;
-    count += kv.second.hits->ratios.empty() ? 0 : 1;
-  }
-  w->put(count);
-  for (const auto& kv : impl.blocks) {
-    if (!kv.second.hits) continue;
-    const std::int64_t bx = detail::blockKeyX(kv.first), by = detail::blockKeyY(kv.first);
-    writeHitRuns(kv.second.hits->counts, bx, by, 0, w);
-    writeHitRuns(kv.second.hits->ratios, bx, by, 1, w);
-  }
-}
-
-// What a version-4 file says of its reflection map.
-struct FileReflection {
-  ReflectionMode mode = ReflectionMode::kOff;
-  detail::ReflectionBasis basis;
-};
-
-// Reads the reflection section into `fresh`'s blocks (read before); `keep`: false drops the hits.
-FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::size_t bytes, Reader* r) {
-  FileReflection f;
-  const auto mode = r->get<std::uint8_t>();
-  const auto type = r->get<std::uint8_t>();
-  if (mode > static_cast<std::uint8_t>(ReflectionMode::kLayers) ||
-      type > static_cast<std::uint8_t>(PolicyType::kClampUpper)) {
-    throw std::runtime_error("bad reflection mode");
-  }
-  f.mode = static_cast<ReflectionMode>(mode);
-  f.basis.type = static_cast<PolicyType>(type);
-  f.basis.odd_occ = r->get<double>();
-  f.basis.odd_emp = r->get<double>();
-  f.basis.init = r->get<double>();
-  const auto count = r->get<std::uint64_t>();
-  if (count > bytes / kHitBlockBytes) throw std::runtime_error("bad hit block count");
-  const std::uint64_t cells_per_block = std::uint64_t{1} << (2 * fresh.levels);
-  for (std::uint64_t i = 0; i < count; ++i) {
-    const auto bx = r->get<std::int32_t>();
-    const auto by = r->get<std::int32_t>();
-    const auto kind = r->get<std::uint8_t>();
-    const auto n = r->get<std::uint32_t>();
-    Block* b = fresh.findBlock(bx, by);
-    if (b == nullptr) throw std::runtime_error("hits in a block the file does not hold");
-    if (kind > 1) throw std::runtime_error("bad hit kind");
-    if (n == 0 || n > cells_per_block || n > bytes / kHitCellBytes) {
-      throw std::runtime_error("bad hit cell count");
-    }
-    if (!b->hits) b->hits = std::make_unique<detail::HitCells>();
-    const auto fill = [&](auto* runs) {
-      if (!runs->entries.empty()) throw std::runtime_error("duplicate hit block");
-      runs->entries.resize(n);
-      for (std::uint32_t j = 0; j < n; ++j) {
-        auto& e = runs->entries[j];
-        e.code = r->get<std::uint32_t>();
-        if (e.code >= cells_per_block || (j > 0 && e.code <= runs->entries[j - 1].code)) {
-          throw std::runtime_error("hit cells out of order");
-        }
-        using Entry = std::decay_t<decltype(e)>;
-        if constexpr (std::is_same_v<Entry, detail::HitCount>) {
-          e.n = r->get<std::uint32_t>();
-        } else {
-          e.q = r->get<float>();
-          if (!std::isfinite(e.q)) throw std::runtime_error("non-finite hit ratio");
-        }
-        if (!e.live()) throw std::runtime_error("empty hit cell");
-      }
-      runs->sorted = n;
-    };
-    if (kind == 0) {
-      fill(&b->hits->counts);
-    } else {
-      fill(&b->hits->ratios);
-    }
-  }
-  if (!keep) {
-    for (auto& kv : fresh.blocks) kv.second.hits.reset();
-  }
-  return f;
-}
-
 double readUnitFactor(Reader* r) {
   const auto a = r->get<double>();
   if (!(a >= 0.0 && a <= 1.0)) throw std::runtime_error("bad forgetting factor");
@@ -474,8 +245,8 @@ void WaveletMap::save(const std::string& path) const {
     w.put(l.unitFactor());
     writeBlocks(l, &w);
   }
-  writeNdt(impl, &w);
-  writeReflection(impl, &w);
+  detail::writeNdt(impl, &w);
+  detail::writeReflection(impl, &w);
   auto& buf = w.buffer();
   const std::uint32_t crc = crc32(buf.data(), buf.size());
   w.put(crc);
@@ -529,29 +300,17 @@ void WaveletMap::load(const std::string& path) {
                    &r);
       }
     }
-    if (version >= 3) readNdt(fresh, impl_->params.ndt, data.size(), &r);
-    FileReflection file;
+    if (version >= 3) detail::readNdt(fresh, impl_->params.ndt, data.size(), &r);
+    detail::FileReflection file;
     if (version >= 4) {
-      file = readReflection(fresh, impl_->params.reflection, data.size(), &r);
+      file = detail::readReflection(fresh, impl_->params.reflection, data.size(), &r);
     } else if (file_layers[0]) {
       file.mode = ReflectionMode::kLayers;  // the hits and misses of older files
       file.basis = fresh.currentBasis();    // not recorded; the layers count whatever it was
     }
-    // The file's reflection map when it was built under this map's basis and holds the layers
-    // its mode needs, else a restart.
     if (impl_->params.reflection) {
-      const bool needs_misses =
-          impl_->params.policy.type != PolicyType::kMax &&
-          (file.mode == ReflectionMode::kLayers || file.mode == ReflectionMode::kCounts);
-      const bool complete = (file.mode != ReflectionMode::kLayers || file_layers[0] != nullptr) &&
-                            (needs_misses ? file_layers[1] != nullptr : file_layers[1] == nullptr);
-      if (file.mode != ReflectionMode::kOff && file.basis == fresh.currentBasis() && complete) {
-        fresh.reflection_mode = file.mode;
-        fresh.hits_layer = std::move(file_layers[0]);
-        fresh.misses_layer = std::move(file_layers[1]);  // made with this map's layer parameters
-      } else {
-        fresh.restartReflection(fresh.blocks.empty());
-      }
+      fresh.adoptReflection(file.mode, file.basis, std::move(file_layers[0]),
+                            std::move(file_layers[1]));
     }
     if (!r.done()) throw std::runtime_error("trailing bytes");
   } catch (const MapIoError&) {

@@ -11,8 +11,10 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include "map_impl.h"
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
@@ -83,6 +85,22 @@ void WaveletMap::Impl::configureReflection() {
     impl.params = layerParams(params, layer == &hits_layer, reflection_mode);
     impl.configure();
   }
+}
+
+void WaveletMap::Impl::adoptReflection(ReflectionMode mode, const detail::ReflectionBasis& basis,
+                                       std::unique_ptr<WaveletMap> hits,
+                                       std::unique_ptr<WaveletMap> misses) {
+  const bool needs_misses = params.policy.type != PolicyType::kMax &&
+                            (mode == ReflectionMode::kLayers || mode == ReflectionMode::kCounts);
+  const bool complete = (mode != ReflectionMode::kLayers || hits != nullptr) &&
+                        (needs_misses ? misses != nullptr : misses == nullptr);
+  if (mode == ReflectionMode::kOff || basis != currentBasis() || !complete) {
+    restartReflection(blocks.empty());
+    return;
+  }
+  reflection_mode = mode;
+  hits_layer = std::move(hits);
+  misses_layer = std::move(misses);  // made with this map's layer parameters
 }
 
 namespace {
@@ -208,21 +226,25 @@ float WaveletMap::reflection(const CellIndex& cell) const {
     const WaveletMap& hits = *impl.hits_layer;
     return hits.isObserved(cell) ? fromCounts(impl, hits.value(cell), 0.0, m) : nan;
   }
+  // One read of the cell's occupancy: its knowledge (or the misses layer's, since a restart under
+  // kCounts) and its log-odds, from which the hits of a ratio are read too.
+  if (!inExtent(cell.x, cell.y)) return nan;
+  const Impl::SlotRead occupancy = impl.read(0, cell.x, cell.y);
   const bool counted_misses = impl.reflection_mode == ReflectionMode::kCounts && impl.misses_layer;
-  if (!(counted_misses ? impl.misses_layer->isObserved(cell) : isObserved(cell))) return nan;
+  if (!(counted_misses ? impl.misses_layer->isObserved(cell) : occupancy.known_all)) return nan;
+  const double l = occupancy.average;
   const int L = impl.levels;
   const std::int64_t mask = (std::int64_t{1} << L) - 1;
-  const double l = impl.read(0, cell.x, cell.y).average;
   double h = 0.0;
   const Block* b = impl.findBlock(detail::floorShift(cell.x, L), detail::floorShift(cell.y, L));
   if (b != nullptr && b->hits) {
     const auto code = detail::mortonCode(static_cast<std::uint32_t>(cell.x & mask),
                                          static_cast<std::uint32_t>(cell.y & mask));
     if (const detail::HitCount* e = b->hits->counts.find(code); e != nullptr && e->live()) {
-      h = hitsOf(impl, *e, cell.x, cell.y);
+      h = static_cast<double>(e->n);
     }
     if (const detail::HitRatio* e = b->hits->ratios.find(code); e != nullptr && e->live()) {
-      h = hitsOf(impl, *e, cell.x, cell.y);
+      h = impl.reflection_basis.hitsFromRatio(l, e->q);
     }
   }
   return fromCounts(impl, l, h, m);
