@@ -38,20 +38,26 @@ template <PolicyType P, bool kNdt, bool kHits = false>
                                              const std::vector<BlockJob>& jobs,
                                              std::atomic<std::size_t>* next) {
   NdtBlockUpdate ndt_update(cls, ndt != nullptr ? *ndt : NdtConsts{});
-  HitBlockUpdate hit_update(impl, hits != nullptr ? *hits : HitConsts{});
-  Integrator<P, kNdt, kHits> integrator(impl, store, cls, pc, &ndt_update,
-                                        hit_update.observations());
+  HitBlockUpdate hit_update(impl, cls, hits != nullptr ? *hits : HitConsts{});
+  Integrator<P, kNdt, kHits> integrator(impl, store, cls, pc, &ndt_update, &hit_update);
   for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < jobs.size();
        i = next->fetch_add(1, std::memory_order_relaxed)) {
     const BlockJob& j = jobs[i];
     store.useSpare(&j.block->spare);
-    if (ndt == nullptr || !j.block->ndt) {
-      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
+    const bool with_ndt = ndt != nullptr && j.block->ndt;
+    const NdtSpan ndt_span =
+        with_ndt ? ndt_update.begin(*j.block->ndt, j.ix0, j.iy0, j.points, j.points_end)
+                 : NdtSpan{};
+    if constexpr (kNdt) {
+      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box, ndt_span);
+    } else if constexpr (kHits && boundsCounts(P)) {
+      // The clamps: the walk counts the misses of the block's hit cells.
+      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box,
+                                hit_update.begin(*j.block, j.ix0, j.iy0));
     } else {
-      const NdtSpan sp = ndt_update.begin(*j.block->ndt, j.ix0, j.iy0, j.points, j.points_end);
-      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box, kNdt ? sp : NdtSpan{});
-      ndt_update.finish();
+      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
     }
+    if (with_ndt) ndt_update.finish();
     if constexpr (kHits) hit_update.finish(*j.block, j.ix0, j.iy0);
   }
   return integrator.visited();

@@ -165,6 +165,54 @@ struct CellRuns {
   }
 };
 
+/// The entries of a block's two sorted runs (CellRuns) under one square: [b1, e1) and [b2, e2).
+template <typename Entry>
+struct CellSpan {
+  Entry *b1 = nullptr, *e1 = nullptr, *b2 = nullptr, *e2 = nullptr;
+
+  bool empty() const { return b1 == e1 && b2 == e2; }
+  /// The entries under child q of the level-l square (their codes' bits 2(l-1), 2(l-1)+1 are q).
+  void split(int l, CellSpan out[4]) const {
+    splitRun(b1, e1, l, &out[0].b1, &out[0].e1, &out[1].b1, &out[1].e1, &out[2].b1, &out[2].e1,
+             &out[3].b1, &out[3].e1);
+    splitRun(b2, e2, l, &out[0].b2, &out[0].e2, &out[1].b2, &out[1].e2, &out[2].b2, &out[2].e2,
+             &out[3].b2, &out[3].e2);
+  }
+  template <typename F>
+  void forEach(F f) const {
+    for (Entry* x = b1; x != e1; ++x) f(x);
+    for (Entry* x = b2; x != e2; ++x) f(x);
+  }
+
+ private:
+  static void splitRun(Entry* b, Entry* e, int l, Entry** b0, Entry** e0, Entry** b1, Entry** e1,
+                       Entry** b2, Entry** e2, Entry** b3, Entry** e3) {
+    const int shift = 2 * (l - 1);
+    const auto upto = [shift](unsigned q) {
+      return [shift, q](const Entry& x) { return ((x.code >> shift) & 3u) <= q; };
+    };
+    Entry* m0 = b == e ? e : std::partition_point(b, e, upto(0));
+    Entry* m1 = m0 == e ? e : std::partition_point(m0, e, upto(1));
+    Entry* m2 = m1 == e ? e : std::partition_point(m1, e, upto(2));
+    *b0 = b;
+    *e0 = *b1 = m0;
+    *e1 = *b2 = m1;
+    *e2 = *b3 = m2;
+    *e3 = e;
+  }
+};
+
+/// Every entry of `runs` (no entry may be added or moved while the span is in use).
+template <typename Entry>
+CellSpan<Entry> spanOf(CellRuns<Entry>* runs) {
+  Entry* base = runs->entries.data();
+  CellSpan<Entry> sp;
+  sp.b1 = base;
+  sp.e1 = sp.b2 = base + runs->sorted;
+  sp.e2 = base + runs->entries.size();
+  return sp;
+}
+
 /// Morton code of the cell at (lx, ly) within its block: x in the even bits, y in the odd ones,
 /// so that the cells of child q = (x bit) + 2 (y bit) of a node at level l share bits 2l and up
 /// and have q in bits 2(l-1), 2(l-1)+1.

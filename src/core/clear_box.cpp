@@ -95,6 +95,7 @@ std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, doubl
     if (b.hits) {
       b.hits->counts.removeIf(in_box);
       b.hits->ratios.removeIf(in_box);
+      b.hits->pairs.removeIf(in_box);
     }
     // The block's groups stay with it (as in an integration, see NodeStore).
     detail::NodeStore store(impl.pool, &b.spare, &impl.nodes, impl.pool.liveCounter());

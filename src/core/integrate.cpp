@@ -99,15 +99,16 @@ std::uint64_t updateBlocksFor(WaveletMap::Impl& impl, detail::NodeStore& store,
                               const std::vector<detail::BlockJob>& jobs,
                               std::atomic<std::size_t>* next) {
   // The Gaussians: "forget" is the one policy whose observations change them.
-  const bool ndt_forgets = P == PolicyType::kForget && ndt != nullptr && ndt->forgets();
-  if (hits != nullptr) {
-    if (ndt_forgets) {
-      return detail::updateBlocks<P, true, true>(impl, store, cls, pc, ndt, hits, jobs, next);
+  if constexpr (P == PolicyType::kForget) {
+    if (ndt != nullptr && ndt->forgets()) {
+      if (hits != nullptr) {
+        return detail::updateBlocks<P, true, true>(impl, store, cls, pc, ndt, hits, jobs, next);
+      }
+      return detail::updateBlocks<P, true>(impl, store, cls, pc, ndt, hits, jobs, next);
     }
-    return detail::updateBlocks<P, false, true>(impl, store, cls, pc, ndt, hits, jobs, next);
   }
-  if (ndt_forgets) {
-    return detail::updateBlocks<P, true>(impl, store, cls, pc, ndt, hits, jobs, next);
+  if (hits != nullptr) {
+    return detail::updateBlocks<P, false, true>(impl, store, cls, pc, ndt, hits, jobs, next);
   }
   return detail::updateBlocks<P, false>(impl, store, cls, pc, ndt, hits, jobs, next);
 }
@@ -171,9 +172,16 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
   if (impl.reflection_mode == ReflectionMode::kDerived ||
       impl.reflection_mode == ReflectionMode::kCounts) {
     hit_consts.ratios = P == PolicyType::kForget;
+    hit_consts.pairs = detail::boundsCounts(P);
     hit_consts.a = a;
     hit_consts.g = g;
+    hit_consts.bound = detail::countBound(p);
+    if (P == PolicyType::kClamp || P == PolicyType::kClampLower) {
+      hit_consts.empty_bound = p.policy.clamp_min;
+    }
     hit_consts.basis = impl.reflection_basis;
+    if (impl.reflection_mode == ReflectionMode::kCounts)
+      hit_consts.misses_layer = impl.misses_layer.get();
     hits = &hit_consts;
   }
   st->blocks_touched = static_cast<std::uint32_t>(jobs.size());

@@ -71,7 +71,8 @@ struct FileReflection {
 /// into `fresh`'s blocks (read before), dropped when not `keep`. Throws std::runtime_error on
 /// inconsistent data.
 void writeReflection(const WaveletMap::Impl& impl, Writer* w);
-FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::size_t bytes, Reader* r);
+FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::uint32_t version,
+                              std::size_t bytes, Reader* r);
 
 }  // namespace detail
 }  // namespace wavog

@@ -28,11 +28,11 @@ inline std::uint8_t withBit(unsigned mask, unsigned bit, bool on) {
 /// How a map keeps its reflection map (MapParams::reflection; reflection.cpp).
 enum class ReflectionMode : std::uint8_t {
   kOff,      ///< no reflection map
-  kDerived,  ///< "none", or "forget" with the unknown prior: hits per hit cell, misses from the
-             ///< occupancy (ReflectionBasis)
+  kDerived,  ///< "none", the clamps, or "forget" with the unknown prior: hits (the clamps: hits
+             ///< and misses) per hit cell, the other misses from the occupancy (ReflectionBasis)
   kPrior,    ///< "forget" with the empty_bound prior: h from the occupancy alone, h + m = 1
-  kCounts,   ///< "max" and the clamps, or "none" restarted: hit counts per hit cell, misses in
-             ///< misses_layer (none under "max")
+  kCounts,   ///< "max", or "none" or the clamps restarted: hits (the clamps: hits and misses)
+             ///< per hit cell, the other misses in misses_layer (none under "max")
   kLayers,   ///< "forget" restarted, or a version 2-3 file: hits and misses in two layers
 };
 

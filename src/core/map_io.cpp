@@ -1,4 +1,4 @@
-// Native map files. Layout (little-endian, version 4):
+// Native map files. Layout (little-endian, version 5):
 //   "WAVOGMAP" | u32 version | f64 resolution | i32 block_levels | f64 prior | f64 a (the factor
 //   one pending unit stands for: 1 - gamma, or 2^-unit with forget_half_life) | u64 block count
 //   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
@@ -11,16 +11,17 @@
 //   (moments about the cell's centre, ndt_store.h)
 //   u8 reflection mode (0 none, 1 derived, 2 prior, 3 counts, 4 layers: map_impl.h) | u8 policy |
 //   f64 odd_occ odd_emp prior (the basis it was built under) | u64 count of blocks with hits,
-//   each: i32 bx | i32 by | u8 kind (0 counts, 1 ratios) | u32 n | n cells ascending by code:
-//   u32 code | u32 count or f32 ratio (reflection_store.h)
+//   each: i32 bx | i32 by | u8 kind (0 counts, 1 ratios, 2 pairs) | u32 n | n cells ascending by
+//   code: u32 code | u32 count, f32 ratio, or f32 hits f32 misses (reflection_store.h)
 //   u32 CRC-32 (IEEE) of every byte before it.
-// Version 3 (before the hits) is the same without the reflection section (its layers hold the
-// hits and misses: kLayers), version 2 (before ndt) also without the NDT section, version 1
-// (before forget_half_life and reflection) also with a u8 pending count and no layers; all load.
-// Stored details and lazy counts are written as they are, so a round trip is bit-exact; a map
-// loaded under another factor applies the file's pending tags while loading.
-// Files are written and read through map_file.h (exclusive temporary + rename, regular files only);
-// the payload sections (Gaussians, hits) are map_payload_io.cpp's.
+// Version 4 is the same without pairs (the clamps counted without bound; such a reflection map
+// restarts on loading). Version 3 (before the hits) is the same without the reflection section (its
+// layers hold the hits and misses: kLayers), version 2 (before ndt) also without the NDT section,
+// version 1 (before forget_half_life and reflection) also with a u8 pending count and no layers;
+// all load. Stored details and lazy counts are written as they are, so a round trip is bit-exact; a
+// map loaded under another factor applies the file's pending tags while loading. Files are written
+// and read through map_file.h (exclusive temporary + rename, regular files only); the payload
+// sections (Gaussians, hits) are map_payload_io.cpp's.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -46,7 +47,7 @@ using detail::Reader;
 using detail::Writer;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
-constexpr std::uint32_t kVersion = 4;
+constexpr std::uint32_t kVersion = 5;
 constexpr std::uint32_t kOldestVersion = 1;  // u8 pending counts
 // Fixed header: magic, version, resolution, block_levels, prior, forgetting factor, block count.
 constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
@@ -303,7 +304,7 @@ void WaveletMap::load(const std::string& path) {
     if (version >= 3) detail::readNdt(fresh, impl_->params.ndt, data.size(), &r);
     detail::FileReflection file;
     if (version >= 4) {
-      file = detail::readReflection(fresh, impl_->params.reflection, data.size(), &r);
+      file = detail::readReflection(fresh, impl_->params.reflection, version, data.size(), &r);
     } else if (file_layers[0]) {
       file.mode = ReflectionMode::kLayers;  // the hits and misses of older files
       file.basis = fresh.currentBasis();    // not recorded; the layers count whatever it was

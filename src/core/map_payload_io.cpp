@@ -1,7 +1,8 @@
 // The payload sections of native map files (layout: map_io.cpp): the blocks' normal-distribution
 // cells (MapParams::ndt, version 3) and the reflection map's mode, basis and hits
-// (MapParams::reflection, version 4). Each block's cells are written live and ascending by Morton
-// code, and read back with every count, order and value checked.
+// (MapParams::reflection, version 4; the clamps' pairs of hits and misses, version 5). Each block's
+// cells are written live and ascending by Morton code, and read back with every count, order and
+// value checked.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -20,6 +21,7 @@ constexpr std::size_t kNdtCellBytes = 4 + 6 * 8;       // code, moments
 constexpr double kMaxNdtWeight = 1e15;                 // end-points of one cell a file may claim
 constexpr std::size_t kHitBlockBytes = 4 + 4 + 1 + 4;  // bx, by, kind, cell count
 constexpr std::size_t kHitCellBytes = 4 + 4;           // code, count or ratio
+constexpr std::size_t kPairCellBytes = 4 + 4 + 4;      // code, hits, misses
 constexpr std::size_t kReflectionHeadBytes = 1 + 1 + 3 * 8 + 8;
 
 // The live entries of `runs`, ascending by code.
@@ -73,6 +75,9 @@ void writeHitRuns(const CellRuns<Entry>& runs, std::int64_t bx, std::int64_t by,
     w->put(e.code);
     if constexpr (std::is_same_v<Entry, HitCount>) {
       w->put(e.n);
+    } else if constexpr (std::is_same_v<Entry, HitPair>) {
+      w->put(e.h);
+      w->put(e.m);
     } else {
       w->put(e.q);
     }
@@ -90,6 +95,12 @@ void readHitRuns(std::uint32_t n, int levels, CellRuns<Entry>* runs, Reader* r) 
     checkCellOrder(runs->entries, j, levels, "hit");
     if constexpr (std::is_same_v<Entry, HitCount>) {
       e.n = r->get<std::uint32_t>();
+    } else if constexpr (std::is_same_v<Entry, HitPair>) {
+      e.h = r->get<float>();
+      e.m = r->get<float>();
+      if (!(std::isfinite(e.h) && std::isfinite(e.m) && e.m >= 0.0f)) {
+        throw std::runtime_error("bad hit pair");
+      }
     } else {
       e.q = r->get<float>();
       if (!std::isfinite(e.q)) throw std::runtime_error("non-finite hit ratio");
@@ -110,8 +121,10 @@ double payloadSectionsBound(std::uint32_t version, std::uint64_t blocks, int lev
              n * (static_cast<double>(kNdtBlockBytes) + cells * static_cast<double>(kNdtCellBytes));
   }
   if (version >= 4) {
+    // Each block may hold counts, ratios and pairs (8, 8, 12 bytes a cell).
     bound += static_cast<double>(kReflectionHeadBytes) +
-             n * (static_cast<double>(kHitBlockBytes) + cells * static_cast<double>(kHitCellBytes));
+             3.0 * n * static_cast<double>(kHitBlockBytes) +
+             n * cells * static_cast<double>(2 * kHitCellBytes + kPairCellBytes);
   }
   return bound;
 }
@@ -179,6 +192,7 @@ void writeReflection(const WaveletMap::Impl& impl, Writer* w) {
     if (!kv.second.hits) continue;
     count += kv.second.hits->counts.empty() ? 0 : 1;
     count += kv.second.hits->ratios.empty() ? 0 : 1;
+    count += kv.second.hits->pairs.empty() ? 0 : 1;
   }
   w->put(count);
   for (const auto& kv : impl.blocks) {
@@ -186,10 +200,12 @@ void writeReflection(const WaveletMap::Impl& impl, Writer* w) {
     const std::int64_t bx = blockKeyX(kv.first), by = blockKeyY(kv.first);
     writeHitRuns(kv.second.hits->counts, bx, by, 0, w);
     writeHitRuns(kv.second.hits->ratios, bx, by, 1, w);
+    writeHitRuns(kv.second.hits->pairs, bx, by, 2, w);
   }
 }
 
-FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::size_t bytes, Reader* r) {
+FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::uint32_t version,
+                              std::size_t bytes, Reader* r) {
   FileReflection f;
   const auto mode = r->get<std::uint8_t>();
   const auto type = r->get<std::uint8_t>();
@@ -209,15 +225,25 @@ FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::size_t by
     const auto by = r->get<std::int32_t>();
     const auto kind = r->get<std::uint8_t>();
     const auto n = r->get<std::uint32_t>();
-    if (kind > 1) throw std::runtime_error("bad hit kind");
-    Block& b = payloadBlock(fresh, bx, by, n, kHitCellBytes, bytes, "hit");
+    // The kind of entries the policy keeps: ratios under "forget", pairs under the clamps (since
+    // version 5), counts otherwise.
+    const std::uint8_t expected = f.basis.type == PolicyType::kForget ? 1
+                                  : boundsCounts(f.basis.type) && version >= 5 ? 2
+                                                                                : 0;
+    if (kind != expected) throw std::runtime_error("hit kind does not match the policy");
+    Block& b =
+        payloadBlock(fresh, bx, by, n, kind == 2 ? kPairCellBytes : kHitCellBytes, bytes, "hit");
     if (!b.hits) b.hits = std::make_unique<HitCells>();
     if (kind == 0) {
       readHitRuns(n, fresh.levels, &b.hits->counts, r);
-    } else {
+    } else if (kind == 1) {
       readHitRuns(n, fresh.levels, &b.hits->ratios, r);
+    } else {
+      readHitRuns(n, fresh.levels, &b.hits->pairs, r);
     }
   }
+  // Before version 5 the clamps counted without bound: such a reflection map restarts.
+  if (version < 5 && boundsCounts(f.basis.type)) f.mode = ReflectionMode::kOff;
   if (!keep) {
     for (auto& kv : fresh.blocks) kv.second.hits.reset();
   }

@@ -39,7 +39,8 @@ MapStats WaveletMap::stats(bool count_observed) const {
     if (hits == nullptr) continue;
     hit_bytes += sizeof(detail::HitCells) +
                  hits->counts.entries.capacity() * sizeof(detail::HitCount) +
-                 hits->ratios.entries.capacity() * sizeof(detail::HitRatio);
+                 hits->ratios.entries.capacity() * sizeof(detail::HitRatio) +
+                 hits->pairs.entries.capacity() * sizeof(detail::HitPair);
   }
   st.reflection_bytes = hit_bytes;
   for (const auto& kv : impl.blocks) {

@@ -69,41 +69,8 @@ class NdtScanPoints {
   std::vector<NdtPoint> points_;
 };
 
-/// The entries of a block's two sorted runs under one square: [b1, e1) and [b2, e2).
-struct NdtSpan {
-  NdtEntry *b1 = nullptr, *e1 = nullptr, *b2 = nullptr, *e2 = nullptr;
-
-  bool empty() const { return b1 == e1 && b2 == e2; }
-  /// The entries under child q of the level-l square (their codes' bits 2(l-1), 2(l-1)+1 are q).
-  void split(int l, NdtSpan out[4]) const {
-    splitRun(b1, e1, l, &out[0].b1, &out[0].e1, &out[1].b1, &out[1].e1, &out[2].b1, &out[2].e1,
-             &out[3].b1, &out[3].e1);
-    splitRun(b2, e2, l, &out[0].b2, &out[0].e2, &out[1].b2, &out[1].e2, &out[2].b2, &out[2].e2,
-             &out[3].b2, &out[3].e2);
-  }
-  template <typename F>
-  void forEach(F f) const {
-    for (NdtEntry* x = b1; x != e1; ++x) f(x);
-    for (NdtEntry* x = b2; x != e2; ++x) f(x);
-  }
-
- private:
-  static void splitRun(NdtEntry* b, NdtEntry* e, int l, NdtEntry** b0, NdtEntry** e0, NdtEntry** b1,
-                       NdtEntry** e1, NdtEntry** b2, NdtEntry** e2, NdtEntry** b3, NdtEntry** e3) {
-    const int shift = 2 * (l - 1);
-    const auto upto = [shift](unsigned q) {
-      return [shift, q](const NdtEntry& x) { return ((x.code >> shift) & 3u) <= q; };
-    };
-    NdtEntry* m0 = b == e ? e : std::partition_point(b, e, upto(0));
-    NdtEntry* m1 = m0 == e ? e : std::partition_point(m0, e, upto(1));
-    NdtEntry* m2 = m1 == e ? e : std::partition_point(m1, e, upto(2));
-    *b0 = b;
-    *e0 = *b1 = m0;
-    *e1 = *b2 = m1;
-    *e2 = *b3 = m2;
-    *e3 = e;
-  }
-};
+/// The Gaussians of a block under one square (cell_runs.h).
+using NdtSpan = CellSpan<NdtEntry>;
 
 /// The policy on the Gaussians for one scan: an observed cell's moments times `a`, each new
 /// end-point weighing `g`, weights capped at `cap`, cells under `min_weight` dropped.
@@ -141,13 +108,8 @@ class NdtBlockUpdate {
     }
     cells.mergeTailIfLong();
     // No entry is added or moved from here to finish().
-    NdtEntry* base = cells.entries.data();
-    base_ = base;
-    NdtSpan sp;
-    sp.b1 = base;
-    sp.e1 = sp.b2 = base + cells.sorted;
-    sp.e2 = base + cells.entries.size();
-    return sp;
+    base_ = cells.entries.data();
+    return spanOf(&cells);
   }
 
   /// The scan observes the cell of entry x (E or O).

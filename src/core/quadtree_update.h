@@ -4,19 +4,21 @@
 // into the parent's details with one forward Haar step. With kNdt (MapParams::ndt and "forget")
 // the walk also carries the span of the block's Gaussians under each square and forgets those the
 // scan observes (ndt_update.h); with kHits (MapParams::reflection) it lists the occupied cells
-// (reflection_update.h). Not installed; included only by src/core/integrate*.cpp.
+// and, under the clamps, carries the span of the block's hit cells and counts a miss on those in
+// free space (reflection_update.h). Not installed; included only by src/core/integrate*.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
 #include "map_slot.h"
 #include "ndt_update.h"
-#include "reflection_store.h"
+#include "reflection_update.h"
 #include "scan_classifier.h"
 #include "update_policy.h"
 #include "wavog_mapping/core/haar.h"
@@ -24,25 +26,33 @@
 namespace wavog {
 namespace detail {
 
-/// The spans of a node's four children: without Gaussians, nothing (every child reads the empty
-/// span), so that the walk without them is the walk it always was.
+/// The spans of a node's four children: without entries to carry, nothing (every child reads
+/// the empty span), so that the walk without them is the walk it always was.
+template <typename Span>
 struct NoSpans {
-  const NdtSpan& operator[](std::size_t) const {
-    static const NdtSpan kNone{};
+  const Span& operator[](std::size_t) const {
+    static const Span kNone{};
     return kNone;
   }
 };
 
 template <PolicyType P, bool kNdt = false, bool kHits = false>
 class Integrator {
-  using Spans = std::conditional_t<kNdt, std::array<NdtSpan, 4>, NoSpans>;
+  // The entries the walk carries down: the Gaussians ("forget" with kNdt), or the hit cells under
+  // the clamps (kHits), which count a miss where the scan crosses them. Never both: the clamps
+  // do not forget Gaussians.
+  static constexpr bool kMissSpans = kHits && boundsCounts(P);
+  static constexpr bool kSpans = kNdt || kMissSpans;
+  static_assert(!(kNdt && kMissSpans), "one kind of span at a time");
+  using Span = std::conditional_t<kNdt, NdtSpan, HitSpan>;
+  using Spans = std::conditional_t<kSpans, std::array<Span, 4>, NoSpans<Span>>;
 
  public:
   /// Node groups come from and go to `store` (one Integrator per thread); with kNdt, the
-  /// Gaussians' forgetting goes to `ndt`; with kHits, the occupied cells go to `hits`.
+  /// Gaussians' forgetting goes to `ndt`; with kHits, the occupied cells go to `hits` (and the
+  /// misses of hit cells under the clamps).
   Integrator(WaveletMap::Impl& impl, NodeStore& store, const ScanClassifier& classifier,
-             const PolicyConsts& pc, NdtBlockUpdate* ndt = nullptr,
-             std::vector<HitObservation>* hits = nullptr)
+             const PolicyConsts& pc, NdtBlockUpdate* ndt = nullptr, HitBlockUpdate* hits = nullptr)
       : impl_(impl),
         store_(store),
         cls_(classifier),
@@ -50,18 +60,19 @@ class Integrator {
         lazy_(impl.params.lazy_forgetting),
         ndt_(ndt),
         hits_(hits),
+        observed_(hits != nullptr ? hits->observations() : nullptr),
         cell_mask_((std::int64_t{1} << impl.levels) - 1) {}
 
   /// Tree nodes and finest cells visited so far.
   std::uint64_t visited() const { return visited_; }
 
-  /// Updates block `b` (origin cell ix0, iy0) classified as `box`; with kNdt, `sp` spans its
-  /// Gaussians.
+  /// Updates block `b` (origin cell ix0, iy0) classified as `box`; `sp` spans the entries it
+  /// carries (kSpans).
   void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, const SquareInfo& box,
-                      const NdtSpan& sp = NdtSpan{}) {
+                      const Span& sp = Span{}) {
     RootSlot slot(impl_, store_, b);
     const double s = b.s;
-    if constexpr (kNdt) enterSlot(sp, box);
+    if constexpr (kSpans) enterSlot(sp, box);
     b.s += updateSlot(slot, box.cls, s,
                       [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
   }
@@ -70,7 +81,7 @@ class Integrator {
   // The rules of one slot of class `cls` whose average is s (U skipped, E at the slot's own
   // scale, the section 3.4 skip); descend(m) updates the slot's node m (the stored one, or a
   // temporary uniform one) when the slot must be refined, and returns the change of its average.
-  // With kNdt, slot_span_ spans the Gaussians under the slot and slot_box_ is a square
+  // With kSpans, slot_span_ spans the entries under the slot and slot_box_ is a square
   // classification holding it (for its cells' classes), set by enterSlot(). Returns the change of
   // the slot's average.
   template <typename Slot, typename Descend>
@@ -81,12 +92,12 @@ class Integrator {
         return 0.0;
       case CellClass::kEmpty:
         if (node == nullptr) {  // uniform block: exact for every policy
-          if constexpr (kNdt) forgetSlot();
+          if constexpr (kSpans) emptySlot(applyPolicy<P>(pc_, CellClass::kEmpty, s));
           slot.setKnown(true, true);
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
         }
         if (kAffineEmpty<P> && node->known_all == 0xF) {
-          if constexpr (kNdt) forgetSlot();
+          if constexpr (kSpans) emptySlot(std::numeric_limits<double>::quiet_NaN());
           if constexpr (P == PolicyType::kForget) forgetSubtree(slot, node);
           slot.setKnown(true, true);
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
@@ -98,6 +109,8 @@ class Integrator {
             std::fabs(applyPolicy<P>(pc_, CellClass::kEmpty, s) - s) <= pc_.unchanged_tol) {
           if constexpr (kNdt) {
             if (!slot_span_.empty()) ndt_->forgetObserved(slot_span_, *slot_box_);
+          } else if constexpr (kMissSpans) {
+            if (!slot_span_.empty()) hits_->missObserved(slot_span_, *slot_box_, s);
           }
           return 0.0;
         }
@@ -108,14 +121,20 @@ class Integrator {
     return refineSlot(slot, node, descend);
   }
 
-  // kNdt: the next slot to update spans `sp`, inside the square classified as `box`.
-  void enterSlot(const NdtSpan& sp, const SquareInfo& box) {
+  // kSpans: the next slot to update spans `sp`, inside the square classified as `box`.
+  void enterSlot(const Span& sp, const SquareInfo& box) {
     slot_span_ = sp;
     slot_box_ = &box;
   }
-  // kNdt: the scan observes every cell of the slot.
-  void forgetSlot() {
-    slot_span_.forEach([this](NdtEntry* x) { ndt_->forget(x); });
+  // kSpans: every cell of the slot is E; `after`: their log-odds after it, when they are all the
+  // same (else NaN).
+  void emptySlot(double after) {
+    if constexpr (kNdt) {
+      (void)after;
+      slot_span_.forEach([this](NdtEntry* x) { ndt_->forget(x); });
+    } else {
+      slot_span_.forEach([this, after](HitPair* x) { hits_->miss(x, after); });
+    }
   }
 
   // The multiplicative part of an E update of a fully known subtree with forgetting: a lazy tag
@@ -143,7 +162,7 @@ class Integrator {
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     Spans parts{};
-    if constexpr (kNdt) slot_span_.split(l, parts.data());
+    if constexpr (kSpans) slot_span_.split(l, parts.data());
     const std::int64_t half = std::int64_t{1} << (l - 1);
     for (int q = 0; q < 4; ++q) {
       const auto qu = static_cast<std::size_t>(q);
@@ -152,7 +171,7 @@ class Integrator {
       ++visited_;
       if (child_box.cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
-      if constexpr (kNdt) enterSlot(parts[qu], child_box);
+      if constexpr (kSpans) enterSlot(parts[qu], child_box);
       delta[qu] = updateSlot(slot, child_box.cls, c[qu], [&](Node& m) {
         return visitNode(m, child_box, l - 1, cx, cy, c[qu]);
       });
@@ -192,7 +211,7 @@ class Integrator {
         const auto q = static_cast<unsigned>(__builtin_ctz(o));
         const auto lx = static_cast<std::uint32_t>((ix0 + (q & 1u)) & cell_mask_);
         const auto ly = static_cast<std::uint32_t>((iy0 + (q >> 1)) & cell_mask_);
-        hits_->push_back({mortonCode(lx, ly), c[q]});
+        observed_->push_back({mortonCode(lx, ly), c[q]});
       }
     } else {
       (void)ix0;
@@ -205,6 +224,12 @@ class Integrator {
       } else if ((cells.o >> q) & 1u) {
         delta[q] = applyPolicy<P>(pc_, CellClass::kOccupied, c[q]) - c[q];
       }
+    }
+    if constexpr (kMissSpans) {
+      slot_span_.forEach([&](HitPair* x) {
+        const unsigned q = x->code & 3u;
+        if ((cells.e >> q) & 1u) hits_->miss(x, c[q] + delta[q]);
+      });
     }
     const auto known = static_cast<std::uint8_t>(cells.e | cells.o);
     n.known_all = (n.known_all | known) & 0xFu;  // 4-bit masks
@@ -221,7 +246,7 @@ class Integrator {
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     Spans parts{};
-    if constexpr (kNdt) slot_span_.split(2, parts.data());
+    if constexpr (kSpans) slot_span_.split(2, parts.data());
     for (int q = 0; q < 4; ++q) {
       ++visited_;
       const auto qu = static_cast<std::size_t>(q);
@@ -231,7 +256,7 @@ class Integrator {
       const CellClass cls = slotClass(cc);
       if (cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
-      if constexpr (kNdt) enterSlot(parts[qu], box);
+      if constexpr (kSpans) enterSlot(parts[qu], box);
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
@@ -268,11 +293,12 @@ class Integrator {
   const PolicyConsts pc_;
   const bool lazy_;
   NdtBlockUpdate* const ndt_;
-  std::vector<HitObservation>* const hits_;
+  HitBlockUpdate* const hits_;
+  std::vector<HitObservation>* const observed_;
   const std::int64_t cell_mask_;  // a finest cell's index within its block
-  // kNdt: the Gaussians under the slot being updated and a classification holding it. A visit
+  // kSpans: the entries under the slot being updated and a classification holding it. A visit
   // reads them on entry (children set them again, one after the other).
-  NdtSpan slot_span_;
+  Span slot_span_;
   const SquareInfo* slot_box_ = nullptr;
   std::uint64_t visited_ = 0;
 };

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
 #include "map_impl.h"
@@ -33,6 +34,14 @@ MapParams WaveletMap::Impl::layerParams(const MapParams& main, bool hits, Reflec
   p.policy.init = forget && !hits ? main.policy.init : InitValue::kUnknown;
   p.sensor.odd_occ = hits ? 1.0 : 0.0;
   p.sensor.odd_emp = hits ? 0.0 : 1.0;
+  if (!hits && mode == ReflectionMode::kCounts && detail::boundsCounts(main.policy.type)) {
+    // The clamps' misses of cells never hit, bounded as their counts are (countBound): counted
+    // down, as -m, so that "clamp_lower" bounds them where the bound is finite.
+    const double bound = detail::countBound(main);
+    p.policy.type = std::isinf(bound) ? PolicyType::kNone : PolicyType::kClampLower;
+    p.policy.clamp_min = std::isinf(bound) ? main.policy.clamp_min : -bound;
+    p.sensor.odd_emp = -1.0;
+  }
   return p;
 }
 
@@ -57,7 +66,7 @@ void WaveletMap::Impl::restartReflection(bool fresh) {
       reflection_mode = params.policy.init == InitValue::kUnknown ? ReflectionMode::kDerived
                                                                   : ReflectionMode::kPrior;
     }
-  } else if (type == PolicyType::kNone && fresh) {
+  } else if ((type == PolicyType::kNone || detail::boundsCounts(type)) && fresh) {
     reflection_mode = ReflectionMode::kDerived;
   } else {
     reflection_mode = ReflectionMode::kCounts;
@@ -100,7 +109,14 @@ void WaveletMap::Impl::adoptReflection(ReflectionMode mode, const detail::Reflec
   }
   reflection_mode = mode;
   hits_layer = std::move(hits);
-  misses_layer = std::move(misses);  // made with this map's layer parameters
+  misses_layer = std::move(misses);
+  // Read with the layer parameters of kLayers: those of this mode from here on.
+  for (std::unique_ptr<WaveletMap>* layer : {&hits_layer, &misses_layer}) {
+    if (!*layer) continue;
+    Impl& impl = *(*layer)->impl_;
+    impl.params = layerParams(params, layer == &hits_layer, reflection_mode);
+    impl.configure();
+  }
 }
 
 namespace {
@@ -127,11 +143,29 @@ double hitsOf(const WaveletMap::Impl& impl, const detail::HitRatio& e, std::int6
               std::int64_t iy) {
   return impl.reflection_basis.hitsFromRatio(impl.read(0, ix, iy).average, e.q);
 }
+double hitsOf(const WaveletMap::Impl&, const detail::HitPair& e, std::int64_t, std::int64_t) {
+  return static_cast<double>(e.h);
+}
 
-// Adds the hits of every hit cell in `window` (scale-s cells) to `sums`, row-major.
+// The clamps: the misses of cell (ix, iy) as if it were never hit (from the misses layer, which
+// holds -m, after a restart; else from the occupancy).
+double unhitMisses(const WaveletMap::Impl& impl, std::int64_t ix, std::int64_t iy) {
+  if (impl.reflection_mode == ReflectionMode::kCounts) {
+    return -static_cast<double>(impl.misses_layer->value({ix, iy}));
+  }
+  return impl.reflection_basis.missesOfUnhit(impl.read(0, ix, iy).average);
+}
+
+// Per scale-s cell of a window, row-major: the mean hits of its cells, and under the clamps the
+// mean of what the entries' misses add to those the cells read as never hit.
+struct HitSums {
+  std::vector<double> h, dm;
+};
+
+// Adds the hits of every hit cell in `window` (scale-s cells) to `sums`.
 template <typename Entry>
 void addHits(const WaveletMap::Impl& impl, const detail::CellRuns<Entry>& runs, std::int64_t x0,
-             std::int64_t y0, int s, const CellBox& window, std::vector<double>* sums) {
+             std::int64_t y0, int s, const CellBox& window, HitSums* sums) {
   for (const Entry& e : runs.entries) {
     if (!e.live()) continue;
     std::uint32_t lx, ly;
@@ -140,14 +174,19 @@ void addHits(const WaveletMap::Impl& impl, const detail::CellRuns<Entry>& runs, 
     const std::int64_t rx = ix >> s, ry = iy >> s;
     if (rx < window.min_x || rx >= window.max_x || ry < window.min_y || ry >= window.max_y)
       continue;
-    (*sums)[static_cast<std::size_t>((ry - window.min_y) * window.width() + (rx - window.min_x))] +=
-        hitsOf(impl, e, ix, iy);
+    const auto k =
+        static_cast<std::size_t>((ry - window.min_y) * window.width() + (rx - window.min_x));
+    sums->h[k] += hitsOf(impl, e, ix, iy);
+    if constexpr (std::is_same_v<Entry, detail::HitPair>) {
+      sums->dm[k] += static_cast<double>(e.m) - unhitMisses(impl, ix, iy);
+    }
   }
 }
 
-// The mean hits of every scale-s cell of `window`, row-major.
-std::vector<double> meanHits(const WaveletMap::Impl& impl, int s, const CellBox& window) {
-  std::vector<double> sums(static_cast<std::size_t>(window.width() * window.height()), 0.0);
+// The hit sums of every scale-s cell of `window`, as means over its cells.
+HitSums meanHits(const WaveletMap::Impl& impl, int s, const CellBox& window) {
+  const auto n = static_cast<std::size_t>(window.width() * window.height());
+  HitSums sums{std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
   const int L = impl.levels;
   const std::int64_t span = std::int64_t{1} << (L - s);  // scale-s cells per block side
   for (const auto& kv : impl.blocks) {
@@ -161,24 +200,29 @@ std::vector<double> meanHits(const WaveletMap::Impl& impl, int s, const CellBox&
     const std::int64_t x0 = detail::scaleUp(bx, L), y0 = detail::scaleUp(by, L);
     addHits(impl, b.hits->counts, x0, y0, s, window, &sums);
     addHits(impl, b.hits->ratios, x0, y0, s, window, &sums);
+    addHits(impl, b.hits->pairs, x0, y0, s, window, &sums);
   }
   const double cells = std::ldexp(1.0, 2 * s);
-  for (double& v : sums) v /= cells;
+  for (double& v : sums.h) v /= cells;
+  for (double& v : sums.dm) v /= cells;
   return sums;
 }
 
 // p of an observed cell or raster cell of mean log-odds `l` (the hits layer's mean under
-// kLayers), mean hits `h` (kDerived, kCounts) and mean misses of the misses layer `m`.
-float fromCounts(const WaveletMap::Impl& impl, double l, double h, double m) {
+// kLayers), mean hits `h` (kDerived, kCounts), mean value of the misses layer `m` and, under the
+// clamps, the entries' mean misses over those of never hit cells `dm`.
+float fromCounts(const WaveletMap::Impl& impl, double l, double h, double m, double dm) {
+  const bool pairs = detail::boundsCounts(impl.reflection_basis.type);
   switch (impl.reflection_mode) {
     case ReflectionMode::kDerived:
+      if (pairs) return probability(h, impl.reflection_basis.missesOfUnhit(l) + dm);
       return probability(h, impl.reflection_basis.misses(l, h));
     case ReflectionMode::kPrior: {
       const double prior_h = impl.reflection_basis.hitsFromRatio(l, 0.0f);  // h + m = 1
       return probability(prior_h, 1.0 - prior_h);
     }
     case ReflectionMode::kCounts:
-      return probability(h, m);
+      return pairs ? probability(h, dm - m) : probability(h, m);
     case ReflectionMode::kLayers:
       return probability(l, m);
     case ReflectionMode::kOff:
@@ -206,14 +250,15 @@ ReflectionRaster WaveletMap::exportReflection(int scale, const CellBox& window) 
   r.cell_size = main.cell_size;
   r.box = main.box;
   r.p.assign(main.log_odds.size(), std::numeric_limits<float>::quiet_NaN());
-  std::vector<double> hits;
+  HitSums hits;
   if (mode == ReflectionMode::kDerived || mode == ReflectionMode::kCounts) {
     hits = meanHits(impl, r.scale, r.box);
   }
   for (std::size_t i = 0; i < r.p.size(); ++i) {
     if (known[i] == 0) continue;
-    r.p[i] = fromCounts(impl, main.log_odds[i], hits.empty() ? 0.0 : hits[i],
-                        impl.misses_layer ? misses.log_odds[i] : 0.0);
+    r.p[i] = fromCounts(impl, main.log_odds[i], hits.h.empty() ? 0.0 : hits.h[i],
+                        impl.misses_layer ? misses.log_odds[i] : 0.0,
+                        hits.dm.empty() ? 0.0 : hits.dm[i]);
   }
   return r;
 }
@@ -224,7 +269,7 @@ float WaveletMap::reflection(const CellIndex& cell) const {
   const double m = impl.misses_layer ? impl.misses_layer->value(cell) : 0.0;
   if (impl.reflection_mode == ReflectionMode::kLayers) {
     const WaveletMap& hits = *impl.hits_layer;
-    return hits.isObserved(cell) ? fromCounts(impl, hits.value(cell), 0.0, m) : nan;
+    return hits.isObserved(cell) ? fromCounts(impl, hits.value(cell), 0.0, m, 0.0) : nan;
   }
   // One read of the cell's occupancy: its knowledge (or the misses layer's, since a restart under
   // kCounts) and its log-odds, from which the hits of a ratio are read too.
@@ -235,7 +280,7 @@ float WaveletMap::reflection(const CellIndex& cell) const {
   const double l = occupancy.average;
   const int L = impl.levels;
   const std::int64_t mask = (std::int64_t{1} << L) - 1;
-  double h = 0.0;
+  double h = 0.0, dm = 0.0;
   const Block* b = impl.findBlock(detail::floorShift(cell.x, L), detail::floorShift(cell.y, L));
   if (b != nullptr && b->hits) {
     const auto code = detail::mortonCode(static_cast<std::uint32_t>(cell.x & mask),
@@ -246,8 +291,13 @@ float WaveletMap::reflection(const CellIndex& cell) const {
     if (const detail::HitRatio* e = b->hits->ratios.find(code); e != nullptr && e->live()) {
       h = impl.reflection_basis.hitsFromRatio(l, e->q);
     }
+    if (const detail::HitPair* e = b->hits->pairs.find(code); e != nullptr && e->live()) {
+      h = e->h;
+      dm = static_cast<double>(e->m) -
+           (counted_misses ? -m : impl.reflection_basis.missesOfUnhit(l));
+    }
   }
-  return fromCounts(impl, l, h, m);
+  return fromCounts(impl, l, h, m, dm);
 }
 
 std::vector<std::int8_t> toOccupancyGrid(const ReflectionRaster& raster) {

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 
 #include "cell_runs.h"
 #include "wavog_mapping/core/params.h"
@@ -34,19 +35,50 @@ struct HitRatio {
   void kill() { q = -1.0f; }
 };
 
-/// A block's hits: `counts` or `ratios`, by the map's policy. `scans`: integrations that met the
-/// block since its ratios were last swept of the cells whose hits have faded; `quiet`: the last
-/// of them in a row without a hit (reflection_update.h).
+/// The hits h and misses m of one hit cell under the clamp policies, whose total is bounded
+/// (ReflectionBasis::bound); a negative h is no entry.
+struct HitPair {
+  std::uint32_t code = 0;
+  float h = -1.0f;
+  float m = 0.0f;
+
+  bool live() const { return h >= 0.0f; }
+  void kill() { h = -1.0f; }
+};
+
+/// A block's hits: `counts`, `ratios` or `pairs`, by the map's policy. `scans`: integrations that
+/// met the block since its ratios were last swept of the cells whose hits have faded; `quiet`: the
+/// last of them in a row without a hit (reflection_update.h).
 struct HitCells {
   CellRuns<HitCount> counts;
   CellRuns<HitRatio> ratios;
+  CellRuns<HitPair> pairs;
   std::uint32_t scans = 0, quiet = 0;
 
-  bool empty() const { return counts.empty() && ratios.empty(); }
+  bool empty() const { return counts.empty() && ratios.empty() && pairs.empty(); }
 };
 
-/// Hits under "forget" below which a cell's ratio is dropped (its h reads 0 from then on).
+/// Hits under "forget" below which a cell's ratio is dropped (its h reads 0 from then on); under
+/// the clamps, the share of its count below which a pair is dropped.
 constexpr double kFadedHits = 1e-7;
+
+/// The policies that bound a cell's count of hits and misses (ReflectionBasis::bound).
+constexpr bool boundsCounts(PolicyType t) {
+  return t == PolicyType::kClamp || t == PolicyType::kClampLower || t == PolicyType::kClampUpper;
+}
+
+/// The clamps' bound on a cell's count of hits and misses: the misses the occupancy's lower
+/// bound holds, clamp_min / odd_emp ("clamp", "clamp_lower"); "clamp_upper", which has none,
+/// counts without bound. A hit cell whose occupancy a miss takes to its empty bound (clamp_min)
+/// forgets its hits: h = 0, m = the bound, what a cell never hit reads there.
+inline double countBound(const MapParams& p) {
+  if (p.policy.type == PolicyType::kClampUpper) return std::numeric_limits<double>::infinity();
+  return p.policy.clamp_min / p.sensor.odd_emp;
+}
+
+/// Log-odds above clamp_min within which a cell's occupancy counts as at its empty bound (float
+/// round-off of the tree's coefficients; the clamps' reflection map resets the cell there).
+constexpr double kAtEmptyBound = 1e-5;
 
 /// What the occupancy of a cell says about its hits h and misses m when the map has applied one
 /// policy with the same odd values and prior since it was empty (ALGORITHM.md; docs/algorithm.md):
@@ -67,6 +99,10 @@ struct ReflectionBasis {
     const double h = (l - odd_emp) / ((odd_occ - odd_emp) - odd_emp * static_cast<double>(q));
     return std::min(1.0, std::max(0.0, h));
   }
+  /// The clamps: the misses of a cell of log-odds `l` that was never hit. Its log-odds are
+  /// max(clamp_min, prior + odd_emp n) after n misses, so l / odd_emp is min(bound, m0 + n) with
+  /// m0 = prior / odd_emp, the misses its prior stands for: exactly its bounded count.
+  double missesOfUnhit(double l) const { return l / odd_emp; }
   /// "forget": A of a cell of log-odds `l` that was never hit (h = 0, m = 1 - A).
   double neverObservedWeight(double l) const {
     return std::min(1.0, std::max(0.0, 1.0 - l / odd_emp));

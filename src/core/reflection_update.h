@@ -2,11 +2,14 @@
 // the quadtree walk (Integrator<P, kNdt, true>, quadtree_update.h) lists the block's occupied
 // cells with their log-odds before the scan, then HitBlockUpdate counts them, or under "forget"
 // renews their ratio q = A / h (reflection_store.h). Free space costs nothing: misses are read
-// from the occupancy. Not installed; included only by src/core/integrate*.cpp.
+// from the occupancy. Under the clamps the walk also carries the span of the block's hit cells
+// and counts a miss on those it finds in free space (their pairs h, m; the total bounded).
+// Not installed; included only by src/core/integrate*.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_REFLECTION_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_REFLECTION_UPDATE_H_
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -14,24 +17,73 @@
 
 #include "map_impl.h"
 #include "reflection_store.h"
+#include "scan_classifier.h"
 
 namespace wavog {
 namespace detail {
 
-/// What a scan does to the hits: count, or (ratios) forget by a = 1 - g with a hit weighing g.
+/// What a scan does to the hits: count, or (ratios) forget by a = 1 - g with a hit weighing g,
+/// or (pairs) count hits and misses with their total bounded at `bound`; the misses of a cell
+/// never hit are read from `misses_layer` (a restart, kCounts: it holds -m) or from the
+/// occupancy.
 struct HitConsts {
   bool ratios = false;
+  bool pairs = false;
   double a = 1.0, g = 0.0;
+  double bound = 0.0;
+  double empty_bound = -std::numeric_limits<double>::infinity();  // clamp_min, if the policy has it
   ReflectionBasis basis;
+  const WaveletMap* misses_layer = nullptr;
 };
+
+/// The span of a block's hit pairs (cell_runs.h).
+using HitSpan = CellSpan<HitPair>;
 
 /// The hits of one block for one scan: observations() is filled by the walk of the block, then
 /// finish() applies them.
 class HitBlockUpdate {
  public:
-  HitBlockUpdate(const WaveletMap::Impl& impl, const HitConsts& c) : impl_(impl), c_(c) {}
+  HitBlockUpdate(const WaveletMap::Impl& impl, const ScanClassifier& cls, const HitConsts& c)
+      : impl_(impl), cls_(cls), c_(c) {}
 
   std::vector<HitObservation>* observations() { return &obs_; }
+
+  /// Pairs: starts block (origin cell ix0, iy0); the span of its hit cells, which the walk
+  /// hands to miss() and missObserved() (no entry is added or moved until finish()).
+  HitSpan begin(Block& b, std::int64_t ix0, std::int64_t iy0) {
+    ix0_ = ix0;
+    iy0_ = iy0;
+    runs_ = b.hits ? &b.hits->pairs : nullptr;
+    return b.hits ? spanOf(&b.hits->pairs) : HitSpan{};
+  }
+  /// Pairs: the scan crosses the cell of entry x (E), whose log-odds are `after` after the scan
+  /// (NaN if not known). A cell the miss takes to the occupancy's empty bound forgets its hits.
+  void miss(HitPair* x, double after) {
+    if (!x->live()) return;
+    if (after <= c_.empty_bound + kAtEmptyBound) {
+      // At the occupancy's empty bound: no hits, a full count of misses, which is what the cell
+      // reads without an entry (l / odd_emp = bound) unless the misses are a restart's layer.
+      if (c_.misses_layer == nullptr) {
+        runs_->drop(x);
+      } else {
+        x->h = 0.0f;
+        x->m = static_cast<float>(c_.bound);
+      }
+      return;
+    }
+    x->m += 1.0f;
+    bound(x);
+  }
+  /// Pairs: every entry of `sp` (cells of a square classified as `box`, of log-odds `l` after the
+  /// scan) whose cell is E.
+  void missObserved(const HitSpan& sp, const SquareInfo& box, double l) {
+    sp.forEach([&](HitPair* x) {
+      if (!x->live()) return;
+      std::uint32_t lx, ly;
+      mortonCell(x->code, &lx, &ly);
+      if (cls_.classifyCell(ix0_ + lx, iy0_ + ly, box) == CellClass::kEmpty) miss(x, l);
+    });
+  }
 
   /// Applies the observations of the block `b` (origin cell ix0, iy0) and clears them.
   void finish(Block& b, std::int64_t ix0, std::int64_t iy0) {
@@ -62,6 +114,32 @@ class HitBlockUpdate {
       if (++cells.scans >= kSweepScans || cells.quiet == kQuietScans) {
         cells.scans = 0;
         sweep(&cells.ratios, ix0, iy0);
+      }
+    } else if (c_.pairs) {
+      cells.pairs.upsertSorted(
+          first, last,
+          [this, ix0, iy0](HitPair& e, const HitObservation& o) {
+            if (!e.live()) {
+              e.h = 0.0f;
+              e.m = static_cast<float>(unhitMisses(o, ix0, iy0));
+            }
+            e.h += 1.0f;
+            bound(&e);
+          },
+          [this, ix0, iy0](const HitObservation& o) {
+            HitPair e;
+            e.code = o.code;
+            e.h = 1.0f;
+            e.m = static_cast<float>(unhitMisses(o, ix0, iy0));
+            bound(&e);
+            return e;
+          });
+      cells.pairs.removeDeadIfMany();  // the walk's drops
+      cells.pairs.mergeTailIfLong();
+      cells.quiet = obs_.empty() ? cells.quiet + 1 : 0;
+      if (++cells.scans >= kSweepScans || cells.quiet == kQuietScans) {
+        cells.scans = 0;
+        sweepPairs(&cells.pairs, ix0, iy0);
       }
     } else {
       cells.counts.upsertSorted(
@@ -98,6 +176,44 @@ class HitBlockUpdate {
     e->q = static_cast<float>(std::min(1.0, c_.a * never) / h);
   }
 
+  // Pairs: the total of hits and misses bounded, keeping their ratio.
+  void bound(HitPair* x) const {
+    const double total = static_cast<double>(x->h) + static_cast<double>(x->m);
+    if (!(total > c_.bound)) return;
+    const double f = c_.bound / total;
+    x->h = static_cast<float>(static_cast<double>(x->h) * f);
+    x->m = static_cast<float>(static_cast<double>(x->m) * f);
+  }
+  // Pairs: the misses of the cell (ix, iy) as if it were never hit: from the misses layer after a
+  // restart, else from its log-odds `l`.
+  double unhitMissesAt(std::int64_t ix, std::int64_t iy, double l) const {
+    if (c_.misses_layer != nullptr) return -static_cast<double>(c_.misses_layer->value({ix, iy}));
+    return c_.basis.missesOfUnhit(l);
+  }
+  // (At least 0: the occupancy's float round-off may leave a hair above the prior.)
+  double unhitMisses(const HitObservation& o, std::int64_t ix0, std::int64_t iy0) const {
+    std::uint32_t lx, ly;
+    mortonCell(o.code, &lx, &ly);
+    return std::max(0.0, unhitMissesAt(ix0 + lx, iy0 + ly, o.before));
+  }
+  // Pairs: drops the entries whose hits have faded to a kFadedHits share of their count and whose
+  // misses are those the cell reads without an entry (to kFadedHits of the bound), so that the
+  // cell's counts change by less than that.
+  void sweepPairs(CellRuns<HitPair>* runs, std::int64_t ix0, std::int64_t iy0) {
+    for (HitPair& e : runs->entries) {
+      if (!e.live()) continue;
+      const double h = e.h, m = e.m;
+      if (!(h <= kFadedHits * (h + m))) continue;
+      std::uint32_t lx, ly;
+      mortonCell(e.code, &lx, &ly);
+      const std::int64_t ix = ix0 + lx, iy = iy0 + ly;
+      const double unhit =
+          unhitMissesAt(ix, iy, c_.misses_layer ? 0.0 : impl_.read(0, ix, iy).average);
+      if (std::fabs(unhit - m) <= kFadedHits * std::max(1.0, m)) runs->drop(&e);
+    }
+    runs->removeDeadIfMany();
+  }
+
   // Drops the ratios of cells whose hits have faded below kFadedHits.
   void sweep(CellRuns<HitRatio>* runs, std::int64_t ix0, std::int64_t iy0) {
     for (HitRatio& e : runs->entries) {
@@ -111,8 +227,11 @@ class HitBlockUpdate {
   }
 
   const WaveletMap::Impl& impl_;
+  const ScanClassifier& cls_;
   const HitConsts c_;
   std::vector<HitObservation> obs_;
+  std::int64_t ix0_ = 0, iy0_ = 0;     // pairs: the block begin() started
+  CellRuns<HitPair>* runs_ = nullptr;  // and its entries
 };
 
 }  // namespace detail

@@ -180,6 +180,16 @@ void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& 
       const std::size_t i = index(ix, iy);
       for (std::size_t k = 0; k < layers_.size(); ++k)
         v_[k][i] = apply(layers_[k], occupied, v_[k][i]);
+      if (v_.size() >= 2 && v_[0][i] + v_[1][i] > sum_bound_) {
+        const double f = sum_bound_ / (v_[0][i] + v_[1][i]);
+        v_[0][i] *= f;
+        v_[1][i] *= f;
+      }
+      if (occupancy_layer_ < v_.size() && v_[0][i] > 0.0 &&
+          v_[occupancy_layer_][i] <= empty_bound_ + 1e-5) {
+        v_[0][i] = 0.0;
+        v_[1][i] = sum_bound_;
+      }
       known_[i] = 1;
       ++last_updated_;
     }

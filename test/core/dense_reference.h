@@ -4,7 +4,10 @@
 #ifndef WAVOG_MAPPING_TEST_CORE_DENSE_REFERENCE_H_
 #define WAVOG_MAPPING_TEST_CORE_DENSE_REFERENCE_H_
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <set>
 #include <utility>
@@ -52,6 +55,24 @@ class DenseReference {
   /// forget_half_life makes them).
   void setGamma(std::size_t layer, double gamma) { layers_.at(layer).policy.gamma = gamma; }
 
+  /// Sets every cell of layer `layer` to `value` (a prior of its own).
+  void setInitial(std::size_t layer, double value) {
+    std::fill(v_.at(layer).begin(), v_.at(layer).end(), value);
+  }
+  /// The clamps' counts of hits (layer 0) and misses (layer 1): after each update of a cell their
+  /// sum is bounded at `bound`, scaling both down, and where the cell has hits and layer
+  /// `occupancy` (if any) is then within 1e-5 of `empty_bound` they become 0 and `bound`.
+  void boundCounts(double bound, std::size_t occupancy = SIZE_MAX,
+                   double empty_bound = -std::numeric_limits<double>::infinity()) {
+    sum_bound_ = bound;
+    occupancy_layer_ = occupancy;
+    empty_bound_ = empty_bound;
+  }
+  /// Replaces the parameters of layer `layer` (same geometry) for the following scans.
+  void setLayerParams(std::size_t layer, const wavog::MapParams& p) { layers_.at(layer) = p; }
+  /// Every cell unobserved again (values kept).
+  void forgetKnowledge() { std::fill(known_.begin(), known_.end(), 0); }
+
   /// Selects the layer that value(), known() and the block functions read (default 0).
   void selectLayer(std::size_t layer) { layer_ = layer; }
   double value(std::int64_t ix, std::int64_t iy) const { return v_[layer_][index(ix, iy)]; }
@@ -94,6 +115,9 @@ class DenseReference {
   std::map<std::pair<std::int64_t, std::int64_t>, Moments> ndt_;  // keyed (iy, ix)
   static wavog::NdtCell gaussian(const Moments& m);
   std::size_t last_updated_ = 0;
+  double sum_bound_ = std::numeric_limits<double>::infinity();
+  std::size_t occupancy_layer_ = SIZE_MAX;
+  double empty_bound_ = -std::numeric_limits<double>::infinity();
 };
 
 }  // namespace wavog_test

@@ -1,10 +1,11 @@
 // The reflection probability map (MapParams::reflection): against a dense reference that counts
 // hits and misses cell by cell (DenseReference layers with the spec's updates: "none" and the
-// clamp policies add 1 to hits in the occupied band and to misses in free space, "forget" applies
-// h <- (1-g) h + g [hit], m <- (1-g) m + g [miss] from h = m = 0, or m = 1 with the empty_bound
-// prior, "max" counts hits only), for every policy and prior, on random scans with every bad beam
-// kind and on the first fr079 scans, at every scale; restarts after policy changes; files of every
-// mode, clearing; off by default.
+// clamp policies add 1 to hits in the occupied band and to misses in free space, the clamps then
+// scale both down to a total of clamp_min / odd_emp ("clamp", "clamp_lower"), from m = prior /
+// odd_emp; "forget" applies h <- (1-g) h + g [hit], m <- (1-g) m + g [miss] from h = m = 0, or
+// m = 1 with the empty_bound prior, "max" counts hits only), for every policy and prior, on random
+// scans with every bad beam kind and on the first fr079 scans, at every scale; restarts after
+// policy changes; files of every mode, clearing; off by default.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -40,6 +41,19 @@ MapParams countingLayer(const MapParams& main, bool hits) {
   return p;
 }
 
+// The clamps: the reference's counts bounded in total as the map's are, reset at the
+// occupancy's (layer 2's) empty bound, misses from those the prior stands for (none after a
+// restart).
+void boundCounts(const MapParams& p, DenseReference* ref, bool restarted) {
+  const PolicyType t = p.policy.type;
+  if (t != PolicyType::kClamp && t != PolicyType::kClampLower && t != PolicyType::kClampUpper)
+    return;
+  if (t != PolicyType::kClampUpper) {
+    ref->boundCounts(p.policy.clamp_min / p.sensor.odd_emp, 2, p.policy.clamp_min);
+  }
+  if (!restarted) ref->setInitial(1, p.initValue() / p.sensor.odd_emp);
+}
+
 MapParams reflectionParams(PolicyType type, double res, int levels,
                            wavog::InitValue init = wavog::InitValue::kUnknown) {
   MapParams p = MapParams::defaultsFor(type);
@@ -52,9 +66,10 @@ MapParams reflectionParams(PolicyType type, double res, int levels,
 
 // p of the reference from its hits (layer 0) and misses (layer 1) over scale-s block (bx, by),
 // and the tolerance of the tree's: kTolerance, plus, where the misses are read from the occupancy
-// ("none", "forget"), the occupancy's own tolerance carried through m = (L - prior - odd_occ h) /
-// odd_emp: kTolerance times the largest |L| of the block's cells (at least 1; |L| <= |prior| +
-// odd_occ h + |odd_emp| m, hundreds under "none"), over |odd_emp| and the block's mean count.
+// (every policy but "max" since the map was empty), the occupancy's own tolerance carried through
+// m = (L - prior - odd_occ h) / odd_emp (or L / odd_emp): kTolerance times the largest |L| of the
+// block's cells (at least 1; |L| <= |prior| + odd_occ h + |odd_emp| m, hundreds under "none"), over
+// |odd_emp| and the block's mean count.
 double referenceP(DenseReference* ref, const MapParams& p, bool hits_only, int s, std::int64_t bx,
                   std::int64_t by, double* tolerance) {
   *tolerance = kTolerance;
@@ -64,8 +79,6 @@ double referenceP(DenseReference* ref, const MapParams& p, bool hits_only, int s
   if (hits_only) return h > 0.0 ? 1.0 : 0.0;
   ref->selectLayer(1);
   const double m = ref->blockMean(s, bx, by);
-  if (p.policy.type != PolicyType::kNone && p.policy.type != PolicyType::kForget)
-    return h / (h + m);
   double largest = 1.0;
   const std::int64_t size = std::int64_t{1} << s;
   for (std::int64_t y = by * size; y < (by + 1) * size; ++y) {
@@ -124,11 +137,14 @@ struct ReflectionRun {
   WaveletMap map;
   DenseReference ref;
   bool hits_only;
-  ReflectionRun(const MapParams& p, const CellBox& extent)
+  // `restarted`: the map's reflection map restarted, from no counts whatever the prior.
+  ReflectionRun(const MapParams& p, const CellBox& extent, bool restarted = false)
       : params(p),
         map(p),
-        ref(std::vector<MapParams>{countingLayer(p, true), countingLayer(p, false)}, extent),
-        hits_only(p.policy.type == PolicyType::kMax) {}
+        ref(std::vector<MapParams>{countingLayer(p, true), countingLayer(p, false), p}, extent),
+        hits_only(p.policy.type == PolicyType::kMax) {
+    boundCounts(p, &ref, restarted);
+  }
   void integrate(const OwnedScan& s) {
     map.integrate(s.pose, s.view());
     ref.integrate(s.pose, s.view());
@@ -165,23 +181,34 @@ TEST(Reflection, PolicyChangesRestartItExactly) {
       {PolicyType::kClamp, PolicyType::kForget},
       {PolicyType::kForget, PolicyType::kNone},
       {PolicyType::kNone, PolicyType::kClamp},
+      {PolicyType::kForget, PolicyType::kClampLower},
+      {PolicyType::kNone, PolicyType::kClampUpper},
       {PolicyType::kForget, PolicyType::kForget}};  // the same policy, another odd_occ
   for (const auto& change : changes) {
     const std::string name =
         std::string(wavog::toString(change.first)) + " -> " + wavog::toString(change.second);
     SCOPED_TRACE(name);
-    WaveletMap map(reflectionParams(change.first, res, 4));
+    const MapParams before = reflectionParams(change.first, res, 4);
+    MapParams after = reflectionParams(change.second, res, 4);
+    if (change.first == change.second) after.sensor.odd_occ += 0.25;
+    WaveletMap map(before);
+    // The reference's occupancy (layer 2) has the map's whole history; its counts start at the
+    // change.
+    ReflectionRun run(after, extent, true);
+    run.ref.setLayerParams(2, before);
     RandomScans scans(99u, half);
     for (int i = 0; i < 60; ++i) {
       const OwnedScan s = scans.next();
       map.integrate(s.pose, s.view());
+      run.ref.integrate(s.pose, s.view());
     }
-    MapParams after = reflectionParams(change.second, res, 4);
-    if (change.first == change.second) after.sensor.odd_occ += 0.25;
     map.setPolicy(after.policy, after.sensor);
+    run.ref.setLayerParams(2, after);
+    run.ref.setInitial(0, 0.0);
+    run.ref.setInitial(1, 0.0);
+    run.ref.forgetKnowledge();
     // Restarted: no count anywhere (NaN, or 0 where the occupancy's knowledge remains).
     for (float v : map.exportReflection(0, extent).p) ASSERT_TRUE(std::isnan(v) || v == 0.0f);
-    ReflectionRun run(after, extent);
     for (int i = 0; i < 120; ++i) {
       const OwnedScan s = scans.next();
       map.integrate(s.pose, s.view());
@@ -201,6 +228,22 @@ TEST(Reflection, PolicyChangesRestartItExactly) {
         run.ref.integrate(s.pose, s.view());
       }
       expectSameReflection(map, &run.ref, false, 4, name + ", gamma 0.1");
+    }
+    // So does a change of the clamps' bound: the counts are bounded anew from the next scan.
+    if (change.second == PolicyType::kClamp) {
+      wavog::PolicyParams tighter = after.policy;
+      tighter.clamp_min = -1.2;
+      map.setPolicy(tighter, after.sensor);
+      MapParams occupancy = after;
+      occupancy.policy = tighter;
+      run.ref.setLayerParams(2, occupancy);
+      run.ref.boundCounts(tighter.clamp_min / after.sensor.odd_emp, 2, tighter.clamp_min);
+      for (int i = 0; i < 40; ++i) {
+        const OwnedScan s = scans.next();
+        map.integrate(s.pose, s.view());
+        run.ref.integrate(s.pose, s.view());
+      }
+      expectSameReflection(map, &run.ref, false, 4, name + ", clamp_min -1.2");
     }
   }
 }
@@ -292,9 +335,9 @@ TEST(Reflection, FilesClearingResetAndPolicyChanges) {
   std::remove(path.c_str());
 }
 
-// Every way the reflection map is kept (misses from the occupancy under "none" and "forget", h
-// from it alone under "forget" with the empty_bound prior, counted misses under the clamps, hits
-// only under "max", two layers after a restart) survives a round trip bit for bit; a map of
+// Every way the reflection map is kept (misses from the occupancy under "none", "forget" and the
+// clamps, h from it alone under "forget" with the empty_bound prior, hits only under "max", a
+// misses layer or two layers after a restart) survives a round trip bit for bit; a map of
 // another basis (odd values) restarts it on loading, as a policy change would.
 TEST(Reflection, FilesKeepEveryModeAndRestartOnAnotherBasis) {
   const std::string path = ::testing::TempDir() + "reflection_modes_" + std::to_string(::getpid());
@@ -307,9 +350,13 @@ TEST(Reflection, FilesKeepEveryModeAndRestartOnAnotherBasis) {
                                    {PolicyType::kForget, wavog::InitValue::kUnknown, false},
                                    {PolicyType::kForget, wavog::InitValue::kEmptyBound, false},
                                    {PolicyType::kClamp, wavog::InitValue::kUnknown, false},
+                                   {PolicyType::kClamp, wavog::InitValue::kEmptyBound, false},
+                                   {PolicyType::kClampUpper, wavog::InitValue::kUnknown, false},
                                    {PolicyType::kMax, wavog::InitValue::kUnknown, false},
                                    {PolicyType::kForget, wavog::InitValue::kUnknown, true},
-                                   {PolicyType::kNone, wavog::InitValue::kUnknown, true}};
+                                   {PolicyType::kNone, wavog::InitValue::kUnknown, true},
+                                   {PolicyType::kClamp, wavog::InitValue::kUnknown, true},
+                                   {PolicyType::kClampUpper, wavog::InitValue::kUnknown, true}};
   const CellBox box{-60, -60, 60, 60};
   for (const Case& c : cases) {
     const std::string name = std::string(wavog::toString(c.type)) + " " + wavog::toString(c.init) +
@@ -319,7 +366,8 @@ TEST(Reflection, FilesKeepEveryModeAndRestartOnAnotherBasis) {
     WaveletMap map(p);
     RandomScans scans(123u, 6.0);
     if (c.restarted) {
-      MapParams before = reflectionParams(PolicyType::kClamp, 0.1, 5);
+      MapParams before = reflectionParams(
+          c.type == PolicyType::kClamp ? PolicyType::kNone : PolicyType::kClamp, 0.1, 5);
       map.setPolicy(before.policy, before.sensor);
       integrateScans(&scans, 30, map);
       map.setPolicy(p.policy, p.sensor);
@@ -359,6 +407,93 @@ TEST(Reflection, FilesKeepEveryModeAndRestartOnAnotherBasis) {
     for (float v : elsewhere.exportReflection(0, box).p) ASSERT_TRUE(std::isnan(v) || v == 0.0f);
   }
   std::remove(path.c_str());
+}
+
+// The clamps bound a cell's count, not its hits and misses apart (paper section 1.3.3): a cell
+// that returns every other beam reads p about 1/2 however long it is watched, its count stays at
+// clamp_min / odd_emp, after it stops returning p falls by that count's window, and once its
+// occupancy reaches the empty bound it reads as a cell never hit.
+TEST(Reflection, ClampsBoundTheCountKeepingTheRatio) {
+  MapParams p = reflectionParams(PolicyType::kClamp, 0.1, 5);
+  const double bound = p.policy.clamp_min / p.sensor.odd_emp;  // 5 with the defaults
+  ASSERT_NEAR(bound, 5.0, 1e-12);
+  WaveletMap map(p);
+  // One beam along +x from (0, 0.05): ending in the cell at x = 2.05, or crossing it.
+  OwnedScan beam;
+  beam.pose = {0.0, 0.05, 0.0};
+  beam.angle_min = 0.0;
+  beam.angle_increment = 0.01;
+  beam.range_min = 0.05;
+  beam.range_max = 30.0;
+  const auto shoot = [&](float range) {
+    beam.ranges.assign(1, range);
+    map.integrate(beam.pose, beam.view());
+  };
+  const wavog::CellIndex cell = map.cellAt(2.05, 0.05);
+  for (int i = 0; i < 400; ++i) shoot(i % 2 == 0 ? 2.05f : 4.05f);
+  // The alternation's fixed points with a count of 5: p = 5/11 after a miss, 6/11 after a hit.
+  EXPECT_NEAR(map.reflection(cell), 5.0 / 11.0, 1e-5);
+  shoot(2.05f);
+  const float after_hit = map.reflection(cell);
+  shoot(4.05f);
+  const float after_miss = map.reflection(cell);
+  EXPECT_NEAR(after_hit, 6.0 / 11.0, 1e-5);
+  EXPECT_NEAR(after_miss, 5.0 / 11.0, 1e-5);
+  // Misses only: the hits scale by 5/6 each.
+  for (int i = 0; i < 12; ++i) shoot(4.05f);
+  EXPECT_NEAR(map.reflection(cell), after_miss * std::pow(5.0 / 6.0, 12), 1e-5);
+  // Its occupancy was at clamp_max = 3.5; two more misses take it to clamp_min (3.5 - 14 * 0.4
+  // < -2), where the cell reads as never hit.
+  EXPECT_GT(map.value(cell), p.policy.clamp_min + 0.1);
+  shoot(4.05f);
+  shoot(4.05f);
+  EXPECT_EQ(map.value(cell), static_cast<float>(p.policy.clamp_min));
+  EXPECT_EQ(map.reflection(cell), 0.0f);
+  // Without the clamps' bound ("none"), the same history reads p = 1/2 only on average and
+  // barely moves after 12 misses: the counts remember all 400 beams.
+  MapParams none = reflectionParams(PolicyType::kNone, 0.1, 5);
+  WaveletMap counting(none);
+  for (int i = 0; i < 401; ++i) {
+    beam.ranges.assign(1, i % 2 == 0 ? 2.05f : 4.05f);
+    counting.integrate(beam.pose, beam.view());
+  }
+  for (int i = 0; i < 13; ++i) {
+    beam.ranges.assign(1, 4.05f);
+    counting.integrate(beam.pose, beam.view());
+  }
+  EXPECT_NEAR(counting.reflection(cell), 201.0 / 414.0, 1e-4);
+}
+
+// test/core/data/clamp_reflection_v4.wavog was saved by the format-version-4 code (unbounded
+// counts under the clamps, in a misses layer) from the 30 scans of RandomScans(20261202, 6 m) with
+// the "clamp" defaults and reflection at 0.2 m, block_levels 6. It loads with the same occupancy;
+// its reflection map restarts (its counts mean something else now) and from then on equals a
+// reference started at the load.
+TEST(Reflection, ClampFilesOfFormatVersion4Restart) {
+  MapParams p = reflectionParams(PolicyType::kClamp, 0.2, 6);
+  const CellBox extent{-40, -40, 40, 40};
+  ReflectionRun run(p, extent, true);
+  RandomScans scans(20261202u, 6.0);
+  for (int i = 0; i < 30; ++i) {
+    const OwnedScan s = scans.next();
+    run.ref.integrate(s.pose, s.view());
+  }
+  WaveletMap loaded(p);
+  loaded.load(std::string(WAVOG_SOURCE_DIR) + "/test/core/data/clamp_reflection_v4.wavog");
+  WaveletMap made(p);
+  RandomScans again(20261202u, 6.0);
+  integrateScans(&again, 30, made);
+  expectSameCells(made, loaded, 30, 0.0);
+  for (float v : loaded.exportReflection(0, extent).p) ASSERT_TRUE(std::isnan(v));
+  run.ref.setInitial(0, 0.0);
+  run.ref.setInitial(1, 0.0);
+  run.ref.forgetKnowledge();
+  for (int i = 0; i < 40; ++i) {
+    const OwnedScan s = again.next();
+    loaded.integrate(s.pose, s.view());
+    run.ref.integrate(s.pose, s.view());
+  }
+  expectSameReflection(loaded, &run.ref, false, 4, "v4 clamp file");
 }
 
 // Section 6.5 for the reflection map: a region seen empty long enough loses its hits too (their

@@ -4,9 +4,10 @@
 // (resolution onwards), framed with the magic, version and a valid CRC-32, so that mutations
 // reach the parser behind the checksum; clear: the rest is the file as it is. Bits 1-2: the
 // loading map's policy (clamp, or forgetting with one of three gammas, so a file's pending
-// forgetting tags are sometimes applied while loading). Bits 3 and 6: the framed version, 4
-// (neither), 1 (bit 3: u8 pending counts), 2 (bit 6: no NDT section) or 3 (both: no hits
-// section). Bit 4: forgetting with forget_half_life (16-bit pending units). Bit 5: the loading
+// forgetting tags are sometimes applied while loading). Bits 3 and 6: the framed version, 5
+// (neither; 4, unbounded clamp counts, with the clamp policy and bit 4), 1 (bit 3: u8 pending
+// counts), 2 (bit 6: no NDT section) or 3 (both: no hits section). Bit 4: forgetting with
+// forget_half_life (16-bit pending units). Bit 5: the loading
 // map keeps normal-distribution cells (MapParams::ndt). Bit 7: it keeps a reflection map
 // (MapParams::reflection).
 #include <zlib.h>
@@ -41,7 +42,8 @@ std::vector<std::uint8_t> frame(const std::uint8_t* body, std::size_t size, std:
 
 std::uint32_t framedVersion(std::uint8_t mode) {
   const bool b3 = (mode & 8) != 0, b6 = (mode & 64) != 0;
-  return b3 ? (b6 ? 3 : 1) : (b6 ? 2 : 4);
+  const bool clamp_v4 = ((mode >> 1) & 3) == 0 && (mode & 16) != 0;
+  return b3 ? (b6 ? 3 : 1) : (b6 ? 2 : (clamp_v4 ? 4 : 5));
 }
 
 // Parameters the file can be loaded with: its own resolution and block_levels when they are

@@ -108,9 +108,14 @@ struct MapParams {
   /// the map's policy: "none" counts, "forget" forgets both by gamma (h <- (1-g) h + g [hit],
   /// m <- (1-g) m + g [miss], from h = m = 0, or m = 1 with the empty_bound prior, as the
   /// occupancy starts at its empty bound), "max" counts hits only (the paper's compression), and
-  /// the clamp policies count unbounded (bounding hits and misses apart would bias p, paper
-  /// section 1.3.3; use "forget" for a bounded reflection map). Under "none" and "forget" the
-  /// misses are read from the occupancy, so only hit cells cost anything. A change of the policy,
+  /// the clamp policies bound a cell's count, not its hits and misses apart (which would bias p,
+  /// paper section 1.3.3): they count, and scale both down to keep h + m <= clamp_min / odd_emp
+  /// (the misses the occupancy's lower bound holds; 5 with the defaults: p is that window's
+  /// ratio), and a hit cell whose occupancy a miss takes to clamp_min forgets its hits (h = 0, as
+  /// a cell never hit reads there); cells start with prior / odd_emp misses; "clamp_upper", with no
+  /// lower bound, counts without bound. The misses of cells never hit are read from the
+  /// occupancy (and under "none" and "forget" those of every cell), so free space costs nothing
+  /// more; the clamps' hit cells are counted as the walk crosses them. A change of the policy,
   /// its odd values or the prior (setPolicy, or a file built under other ones) restarts it from no
   /// counts. Off by default: maps, speed and files are then those without it.
   bool reflection = false;
