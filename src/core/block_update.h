@@ -52,8 +52,8 @@ template <PolicyType P, bool kNdt, bool kHits = false>
       integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box, ndt_span);
     } else if constexpr (kHits && boundsCounts(P)) {
       // The clamps: the walk counts the misses of the block's hit cells.
-      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box,
-                                hit_update.begin(*j.block, j.ix0, j.iy0));
+      hit_update.begin(*j.block, j.ix0, j.iy0);
+      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
     } else {
       integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
     }

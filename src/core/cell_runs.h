@@ -5,6 +5,7 @@
 #define WAVOG_MAPPING_SRC_CORE_CELL_RUNS_H_
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -169,6 +170,8 @@ struct CellRuns {
 template <typename Entry>
 struct CellSpan {
   Entry *b1 = nullptr, *e1 = nullptr, *b2 = nullptr, *e2 = nullptr;
+  /// Runs at most this long are split by one linear pass, longer ones by binary searches.
+  static constexpr std::ptrdiff_t kLinearSplit = 16;
 
   bool empty() const { return b1 == e1 && b2 == e2; }
   /// The entries under child q of the level-l square (their codes' bits 2(l-1), 2(l-1)+1 are q).
@@ -188,12 +191,28 @@ struct CellSpan {
   static void splitRun(Entry* b, Entry* e, int l, Entry** b0, Entry** e0, Entry** b1, Entry** e1,
                        Entry** b2, Entry** e2, Entry** b3, Entry** e3) {
     const int shift = 2 * (l - 1);
-    const auto upto = [shift](unsigned q) {
-      return [shift, q](const Entry& x) { return ((x.code >> shift) & 3u) <= q; };
-    };
-    Entry* m0 = b == e ? e : std::partition_point(b, e, upto(0));
-    Entry* m1 = m0 == e ? e : std::partition_point(m0, e, upto(1));
-    Entry* m2 = m1 == e ? e : std::partition_point(m1, e, upto(2));
+    Entry *m0, *m1, *m2;
+    if (e - b <= kLinearSplit) {
+      // Short runs (most, near the finest cells): count each child's entries in one pass without
+      // a branch on the codes (they are sorted, so the counts place the cuts).
+      std::ptrdiff_t n0 = 0, n1 = 0, n2 = 0;
+      for (const Entry* x = b; x != e; ++x) {
+        const unsigned q = (x->code >> shift) & 3u;
+        n0 += q == 0;
+        n1 += q <= 1;
+        n2 += q <= 2;
+      }
+      m0 = b + n0;
+      m1 = b + n1;
+      m2 = b + n2;
+    } else {
+      const auto upto = [shift](unsigned q) {
+        return [shift, q](const Entry& x) { return ((x.code >> shift) & 3u) <= q; };
+      };
+      m0 = std::partition_point(b, e, upto(0));
+      m1 = m0 == e ? e : std::partition_point(m0, e, upto(1));
+      m2 = m1 == e ? e : std::partition_point(m1, e, upto(2));
+    }
     *b0 = b;
     *e0 = *b1 = m0;
     *e1 = *b2 = m1;

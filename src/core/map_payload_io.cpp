@@ -227,9 +227,9 @@ FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::uint32_t 
     const auto n = r->get<std::uint32_t>();
     // The kind of entries the policy keeps: ratios under "forget", pairs under the clamps (since
     // version 5), counts otherwise.
-    const std::uint8_t expected = f.basis.type == PolicyType::kForget ? 1
+    const std::uint8_t expected = f.basis.type == PolicyType::kForget          ? 1
                                   : boundsCounts(f.basis.type) && version >= 5 ? 2
-                                                                                : 0;
+                                                                               : 0;
     if (kind != expected) throw std::runtime_error("hit kind does not match the policy");
     Block& b =
         payloadBlock(fresh, bx, by, n, kind == 2 ? kPairCellBytes : kHitCellBytes, bytes, "hit");

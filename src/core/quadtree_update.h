@@ -38,13 +38,12 @@ struct NoSpans {
 
 template <PolicyType P, bool kNdt = false, bool kHits = false>
 class Integrator {
-  // The entries the walk carries down: the Gaussians ("forget" with kNdt), or the hit cells under
-  // the clamps (kHits), which count a miss where the scan crosses them. Never both: the clamps
-  // do not forget Gaussians.
-  static constexpr bool kMissSpans = kHits && boundsCounts(P);
-  static constexpr bool kSpans = kNdt || kMissSpans;
-  static_assert(!(kNdt && kMissSpans), "one kind of span at a time");
-  using Span = std::conditional_t<kNdt, NdtSpan, HitSpan>;
+  // The Gaussians the walk carries down ("forget" with kNdt); under the clamps (kHits), the hit
+  // cells it counts a miss on where the scan crosses them, met in code order by a cursor
+  // (HitBlockUpdate::missRange), since the walk visits the squares in code order.
+  static constexpr bool kSpans = kNdt;
+  static constexpr bool kMissCursor = kHits && boundsCounts(P);
+  using Span = NdtSpan;
   using Spans = std::conditional_t<kSpans, std::array<Span, 4>, NoSpans<Span>>;
 
  public:
@@ -73,6 +72,7 @@ class Integrator {
     RootSlot slot(impl_, store_, b);
     const double s = b.s;
     if constexpr (kSpans) enterSlot(sp, box);
+    if constexpr (kMissCursor) enterCells(0, impl_.levels, box);
     b.s += updateSlot(slot, box.cls, s,
                       [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
   }
@@ -92,12 +92,18 @@ class Integrator {
         return 0.0;
       case CellClass::kEmpty:
         if (node == nullptr) {  // uniform block: exact for every policy
-          if constexpr (kSpans) emptySlot(applyPolicy<P>(pc_, CellClass::kEmpty, s));
+          if constexpr (kSpans) emptySlot();
+          if constexpr (kMissCursor) {
+            hits_->missRange(slot_code_, slot_level_, applyPolicy<P>(pc_, CellClass::kEmpty, s));
+          }
           slot.setKnown(true, true);
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
         }
         if (kAffineEmpty<P> && node->known_all == 0xF) {
-          if constexpr (kSpans) emptySlot(std::numeric_limits<double>::quiet_NaN());
+          if constexpr (kSpans) emptySlot();
+          if constexpr (kMissCursor) {  // clamp_upper, which has no empty bound
+            hits_->missRange(slot_code_, slot_level_, std::numeric_limits<double>::quiet_NaN());
+          }
           if constexpr (P == PolicyType::kForget) forgetSubtree(slot, node);
           slot.setKnown(true, true);
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
@@ -109,8 +115,8 @@ class Integrator {
             std::fabs(applyPolicy<P>(pc_, CellClass::kEmpty, s) - s) <= pc_.unchanged_tol) {
           if constexpr (kNdt) {
             if (!slot_span_.empty()) ndt_->forgetObserved(slot_span_, *slot_box_);
-          } else if constexpr (kMissSpans) {
-            if (!slot_span_.empty()) hits_->missObserved(slot_span_, *slot_box_, s);
+          } else if constexpr (kMissCursor) {
+            hits_->missObservedRange(slot_code_, slot_level_, *slot_box_, s);
           }
           return 0.0;
         }
@@ -126,15 +132,21 @@ class Integrator {
     slot_span_ = sp;
     slot_box_ = &box;
   }
-  // kSpans: every cell of the slot is E; `after`: their log-odds after it, when they are all the
-  // same (else NaN).
-  void emptySlot(double after) {
-    if constexpr (kNdt) {
-      (void)after;
-      slot_span_.forEach([this](NdtEntry* x) { ndt_->forget(x); });
-    } else {
-      slot_span_.forEach([this, after](HitPair* x) { hits_->miss(x, after); });
-    }
+  // kMissCursor: the next slot to update holds the cells of codes [code, code + 4^level), inside
+  // the square classified as `box`.
+  void enterCells(std::uint32_t code, int level, const SquareInfo& box) {
+    slot_code_ = code;
+    slot_level_ = level;
+    slot_box_ = &box;
+  }
+  // kSpans: every cell of the slot is E.
+  void emptySlot() {
+    slot_span_.forEach([this](NdtEntry* x) { ndt_->forget(x); });
+  }
+  // The code of the finest cell (ix, iy) within its block.
+  std::uint32_t codeOf(std::int64_t ix, std::int64_t iy) const {
+    return mortonCode(static_cast<std::uint32_t>(ix & cell_mask_),
+                      static_cast<std::uint32_t>(iy & cell_mask_));
   }
 
   // The multiplicative part of an E update of a fully known subtree with forgetting: a lazy tag
@@ -172,6 +184,7 @@ class Integrator {
       if (child_box.cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
       if constexpr (kSpans) enterSlot(parts[qu], child_box);
+      if constexpr (kMissCursor) enterCells(codeOf(cx, cy), l - 1, child_box);
       delta[qu] = updateSlot(slot, child_box.cls, c[qu], [&](Node& m) {
         return visitNode(m, child_box, l - 1, cx, cy, c[qu]);
       });
@@ -225,12 +238,7 @@ class Integrator {
         delta[q] = applyPolicy<P>(pc_, CellClass::kOccupied, c[q]) - c[q];
       }
     }
-    if constexpr (kMissSpans) {
-      slot_span_.forEach([&](HitPair* x) {
-        const unsigned q = x->code & 3u;
-        if ((cells.e >> q) & 1u) hits_->miss(x, c[q] + delta[q]);
-      });
-    }
+    if constexpr (kMissCursor) hits_->missCells(codeOf(ix0, iy0), cells.e, c, delta);
     const auto known = static_cast<std::uint8_t>(cells.e | cells.o);
     n.known_all = (n.known_all | known) & 0xFu;  // 4-bit masks
     n.known_any = (n.known_any | known) & 0xFu;
@@ -257,6 +265,9 @@ class Integrator {
       if (cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
       if constexpr (kSpans) enterSlot(parts[qu], box);
+      if constexpr (kMissCursor) {
+        enterCells(codeOf(ix0 + (q & 1) * 2, iy0 + (q >> 1) * 2), 1, box);
+      }
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
@@ -296,10 +307,13 @@ class Integrator {
   HitBlockUpdate* const hits_;
   std::vector<HitObservation>* const observed_;
   const std::int64_t cell_mask_;  // a finest cell's index within its block
-  // kSpans: the entries under the slot being updated and a classification holding it. A visit
-  // reads them on entry (children set them again, one after the other).
+  // kSpans: the entries under the slot being updated and a classification holding it (kSpans,
+  // kMissCursor). A visit reads them on entry (children set them again, one after the other).
   Span slot_span_;
   const SquareInfo* slot_box_ = nullptr;
+  // kMissCursor: the codes of the slot being updated, [slot_code_, slot_code_ + 4^slot_level_).
+  std::uint32_t slot_code_ = 0;
+  int slot_level_ = 0;
   std::uint64_t visited_ = 0;
 };
 

@@ -2,13 +2,14 @@
 // the quadtree walk (Integrator<P, kNdt, true>, quadtree_update.h) lists the block's occupied
 // cells with their log-odds before the scan, then HitBlockUpdate counts them, or under "forget"
 // renews their ratio q = A / h (reflection_store.h). Free space costs nothing: misses are read
-// from the occupancy. Under the clamps the walk also carries the span of the block's hit cells
-// and counts a miss on those it finds in free space (their pairs h, m; the total bounded).
+// from the occupancy. Under the clamps the walk also counts a miss on the hit cells it finds in
+// free space (their pairs h, m; the total bounded), met by a cursor in code order.
 // Not installed; included only by src/core/integrate*.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_REFLECTION_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_REFLECTION_UPDATE_H_
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -44,45 +45,71 @@ using HitSpan = CellSpan<HitPair>;
 class HitBlockUpdate {
  public:
   HitBlockUpdate(const WaveletMap::Impl& impl, const ScanClassifier& cls, const HitConsts& c)
-      : impl_(impl), cls_(cls), c_(c) {}
+      : impl_(impl), cls_(cls), c_(c), bound_(static_cast<float>(c.bound)) {}
 
   std::vector<HitObservation>* observations() { return &obs_; }
 
-  /// Pairs: starts block (origin cell ix0, iy0); the span of its hit cells, which the walk
-  /// hands to miss() and missObserved() (no entry is added or moved until finish()).
-  HitSpan begin(Block& b, std::int64_t ix0, std::int64_t iy0) {
+  /// Pairs: starts block (origin cell ix0, iy0), whose walk then hands the squares and cells it
+  /// finds E to missRange(), missObservedRange() and missCells(), in code order (no entry is
+  /// added or moved until finish()).
+  void begin(Block& b, std::int64_t ix0, std::int64_t iy0) {
     ix0_ = ix0;
     iy0_ = iy0;
     runs_ = b.hits ? &b.hits->pairs : nullptr;
-    return b.hits ? spanOf(&b.hits->pairs) : HitSpan{};
+    const HitSpan all = b.hits ? spanOf(&b.hits->pairs) : HitSpan{};
+    at1_ = all.b1;
+    end1_ = all.e1;
+    at2_ = all.b2;
+    end2_ = all.e2;
+  }
+  /// Pairs: every cell of codes [code, code + 4^level) is E, of log-odds `after` after the scan.
+  void missRange(std::uint32_t code, int level, double after) {
+    inRange(code, code + (1u << (2 * level)), [&](HitPair* x) { miss(x, after); });
+  }
+  /// Pairs: the cells of codes [code, code + 4^level) (a square classified as `box`, of log-odds
+  /// `l`) that are E.
+  void missObservedRange(std::uint32_t code, int level, const SquareInfo& box, double l) {
+    inRange(code, code + (1u << (2 * level)), [&](HitPair* x) {
+      if (!x->live()) return;
+      std::uint32_t lx, ly;
+      mortonCell(x->code, &lx, &ly);
+      if (cls_.classifyCell(ix0_ + lx, iy0_ + ly, box) == CellClass::kEmpty) miss(x, l);
+    });
+  }
+  /// Pairs: the 4 cells of codes [code, code + 4), cell q E by bit q of `empty`, of log-odds
+  /// c[q] + delta[q] after the scan.
+  void missCells(std::uint32_t code, std::uint32_t empty, const std::array<double, 4>& c,
+                 const std::array<double, 4>& delta) {
+    inRange(code, code + 4, [&](HitPair* x) {
+      const unsigned q = x->code & 3u;
+      missIf(x, (empty >> q) & 1u, c[q] + delta[q]);
+    });
   }
   /// Pairs: the scan crosses the cell of entry x (E), whose log-odds are `after` after the scan
   /// (NaN if not known). A cell the miss takes to the occupancy's empty bound forgets its hits.
-  void miss(HitPair* x, double after) {
-    if (!x->live()) return;
-    if (after <= c_.empty_bound + kAtEmptyBound) {
+  void miss(HitPair* x, double after) { missIf(x, true, after); }
+  /// Pairs: miss(x, after) if `empty`, else nothing; without a branch on `empty` but where the
+  /// miss takes the cell to the empty bound (the walk's finest cells, whose classes the branch
+  /// predictor cannot guess).
+  void missIf(HitPair* x, bool empty, double after) {
+    const bool apply = empty && x->live();
+    if (apply && after <= c_.empty_bound + kAtEmptyBound) {
       // At the occupancy's empty bound: no hits, a full count of misses, which is what the cell
       // reads without an entry (l / odd_emp = bound) unless the misses are a restart's layer.
       if (c_.misses_layer == nullptr) {
         runs_->drop(x);
       } else {
         x->h = 0.0f;
-        x->m = static_cast<float>(c_.bound);
+        x->m = bound_;
       }
       return;
     }
-    x->m += 1.0f;
-    bound(x);
-  }
-  /// Pairs: every entry of `sp` (cells of a square classified as `box`, of log-odds `l` after the
-  /// scan) whose cell is E.
-  void missObserved(const HitSpan& sp, const SquareInfo& box, double l) {
-    sp.forEach([&](HitPair* x) {
-      if (!x->live()) return;
-      std::uint32_t lx, ly;
-      mortonCell(x->code, &lx, &ly);
-      if (cls_.classifyCell(ix0_ + lx, iy0_ + ly, box) == CellClass::kEmpty) miss(x, l);
-    });
+    // m + 1, then both scaled to keep h + m <= bound (h + m <= bound held before, so an entry
+    // left alone scales by 1).
+    const float h = x->h, m = x->m + (apply ? 1.0f : 0.0f);
+    const float f = apply ? std::min(1.0f, bound_ / (h + m)) : 1.0f;
+    x->h = h * f;
+    x->m = m * f;
   }
 
   /// Applies the observations of the block `b` (origin cell ix0, iy0) and clears them.
@@ -176,13 +203,37 @@ class HitBlockUpdate {
     e->q = static_cast<float>(std::min(1.0, c_.a * never) / h);
   }
 
+  // Pairs: f(x) on the entries of codes [c0, c1) of both runs, from where the last range ended
+  // (ranges come in ascending order).
+  template <typename F>
+  void inRange(std::uint32_t c0, std::uint32_t c1, F f) {
+    at1_ = skipTo(at1_, end1_, c0);
+    for (; at1_ != end1_ && at1_->code < c1; ++at1_) f(at1_);
+    at2_ = skipTo(at2_, end2_, c0);
+    for (; at2_ != end2_ && at2_->code < c1; ++at2_) f(at2_);
+  }
+  // The first entry of [b, e) (ascending) whose code is not below `code`: steps of 1, 2, 4, ...
+  // from b, then a binary search in the last one.
+  static HitPair* skipTo(HitPair* b, HitPair* e, std::uint32_t code) {
+    if (b == e || b->code >= code) return b;
+    std::size_t step = 1;
+    HitPair* lo = b;
+    for (;;) {
+      const auto left = static_cast<std::size_t>(e - lo);
+      HitPair* hi = lo + std::min(step, left);
+      if (hi == e || hi->code >= code) {
+        return std::lower_bound(lo, hi, code,
+                                [](const HitPair& x, std::uint32_t c) { return x.code < c; });
+      }
+      lo = hi;
+      step *= 2;
+    }
+  }
   // Pairs: the total of hits and misses bounded, keeping their ratio.
   void bound(HitPair* x) const {
-    const double total = static_cast<double>(x->h) + static_cast<double>(x->m);
-    if (!(total > c_.bound)) return;
-    const double f = c_.bound / total;
-    x->h = static_cast<float>(static_cast<double>(x->h) * f);
-    x->m = static_cast<float>(static_cast<double>(x->m) * f);
+    const float f = std::min(1.0f, bound_ / (x->h + x->m));
+    x->h *= f;
+    x->m *= f;
   }
   // Pairs: the misses of the cell (ix, iy) as if it were never hit: from the misses layer after a
   // restart, else from its log-odds `l`.
@@ -229,9 +280,11 @@ class HitBlockUpdate {
   const WaveletMap::Impl& impl_;
   const ScanClassifier& cls_;
   const HitConsts c_;
+  const float bound_;  // c_.bound
   std::vector<HitObservation> obs_;
   std::int64_t ix0_ = 0, iy0_ = 0;     // pairs: the block begin() started
-  CellRuns<HitPair>* runs_ = nullptr;  // and its entries
+  CellRuns<HitPair>* runs_ = nullptr;  // and its entries: the walk's cursors in their two runs
+  HitPair *at1_ = nullptr, *end1_ = nullptr, *at2_ = nullptr, *end2_ = nullptr;
 };
 
 }  // namespace detail
