@@ -74,6 +74,19 @@ struct CellRuns {
       if (!e->live()) --dead;
       update(*e, *it);
     }
+    mergeAdded(old_size);
+  }
+  /// For items [first, last) ascending by `code`, none of whose cells has an entry (live or
+  /// dead): new entries make(item), joining the tail as one sorted batch.
+  template <typename Item, typename Make>
+  void insertNewSorted(const Item* first, const Item* last, Make make) {
+    const std::size_t old_size = entries.size();
+    reserveFor(static_cast<std::size_t>(last - first));
+    for (const Item* it = first; it != last; ++it) entries.push_back(make(*it));
+    mergeAdded(old_size);
+  }
+  /// Merges the entries from `old_size` on (new, ascending) into the tail.
+  void mergeAdded(std::size_t old_size) {
     added_ = entries.size() - old_size;
     if (added_ == 0) return;
     // The new entries into the tail, from the back: each entry moves once.

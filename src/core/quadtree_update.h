@@ -219,8 +219,21 @@ class Integrator {
       });
     }
     const std::array<double, 4> c = haar::backward(s, n.d);
+    std::array<double, 4> delta{};
+    for (std::size_t q = 0; q < 4; ++q) {
+      if ((cells.e >> q) & 1u) {
+        delta[q] = applyPolicy<P>(pc_, CellClass::kEmpty, c[q]) - c[q];
+      } else if ((cells.o >> q) & 1u) {
+        delta[q] = applyPolicy<P>(pc_, CellClass::kOccupied, c[q]) - c[q];
+      }
+    }
     if constexpr (kHits) {
-      for (std::uint32_t o = cells.o; o != 0; o &= o - 1) {
+      // Under the clamps the cells with an entry are counted on the way (slot_code_: this
+      // level-1 node's, entered by its parent); the other O cells are listed.
+      std::uint32_t listed = cells.o;
+      if constexpr (kMissCursor)
+        listed &= ~hits_->visitCells(slot_code_, cells.e, cells.o, c, delta);
+      for (std::uint32_t o = listed; o != 0; o &= o - 1) {
         const auto q = static_cast<unsigned>(__builtin_ctz(o));
         const auto lx = static_cast<std::uint32_t>((ix0 + (q & 1u)) & cell_mask_);
         const auto ly = static_cast<std::uint32_t>((iy0 + (q >> 1)) & cell_mask_);
@@ -230,15 +243,6 @@ class Integrator {
       (void)ix0;
       (void)iy0;
     }
-    std::array<double, 4> delta{};
-    for (std::size_t q = 0; q < 4; ++q) {
-      if ((cells.e >> q) & 1u) {
-        delta[q] = applyPolicy<P>(pc_, CellClass::kEmpty, c[q]) - c[q];
-      } else if ((cells.o >> q) & 1u) {
-        delta[q] = applyPolicy<P>(pc_, CellClass::kOccupied, c[q]) - c[q];
-      }
-    }
-    if constexpr (kMissCursor) hits_->missCells(codeOf(ix0, iy0), cells.e, c, delta);
     const auto known = static_cast<std::uint8_t>(cells.e | cells.o);
     n.known_all = (n.known_all | known) & 0xFu;  // 4-bit masks
     n.known_any = (n.known_any | known) & 0xFu;

@@ -76,14 +76,23 @@ class HitBlockUpdate {
       if (cls_.classifyCell(ix0_ + lx, iy0_ + ly, box) == CellClass::kEmpty) miss(x, l);
     });
   }
-  /// Pairs: the 4 cells of codes [code, code + 4), cell q E by bit q of `empty`, of log-odds
-  /// c[q] + delta[q] after the scan.
-  void missCells(std::uint32_t code, std::uint32_t empty, const std::array<double, 4>& c,
-                 const std::array<double, 4>& delta) {
+  /// Pairs: the 4 cells of codes [code, code + 4), cell q E by bit q of `empty` and O by bit q of
+  /// `occupied`, of log-odds c[q] before the scan and c[q] + delta[q] after it. The hits of those
+  /// O cells that have an entry (live or dead) are counted here; returns their bits (the others
+  /// are new cells, for finish()).
+  std::uint32_t visitCells(std::uint32_t code, std::uint32_t empty, std::uint32_t occupied,
+                           const std::array<double, 4>& c, const std::array<double, 4>& delta) {
+    std::uint32_t counted = 0;
     inRange(code, code + 4, [&](HitPair* x) {
       const unsigned q = x->code & 3u;
-      missIf(x, (empty >> q) & 1u, c[q] + delta[q]);
+      if ((occupied >> q) & 1u) {
+        hit(x, c[q]);
+        counted |= 1u << q;
+      } else {
+        missIf(x, (empty >> q) & 1u, c[q] + delta[q]);
+      }
     });
+    return counted;
   }
   /// Pairs: the scan crosses the cell of entry x (E), whose log-odds are `after` after the scan
   /// (NaN if not known). A cell the miss takes to the occupancy's empty bound forgets its hits.
@@ -143,24 +152,15 @@ class HitBlockUpdate {
         sweep(&cells.ratios, ix0, iy0);
       }
     } else if (c_.pairs) {
-      cells.pairs.upsertSorted(
-          first, last,
-          [this, ix0, iy0](HitPair& e, const HitObservation& o) {
-            if (!e.live()) {
-              e.h = 0.0f;
-              e.m = static_cast<float>(unhitMisses(o, ix0, iy0));
-            }
-            e.h += 1.0f;
-            bound(&e);
-          },
-          [this, ix0, iy0](const HitObservation& o) {
-            HitPair e;
-            e.code = o.code;
-            e.h = 1.0f;
-            e.m = static_cast<float>(unhitMisses(o, ix0, iy0));
-            bound(&e);
-            return e;
-          });
+      // The walk counted the cells with an entry (visitCells): these are new.
+      cells.pairs.insertNewSorted(first, last, [this, ix0, iy0](const HitObservation& o) {
+        HitPair e;
+        e.code = o.code;
+        e.h = 1.0f;
+        e.m = static_cast<float>(unhitMisses(o, ix0, iy0));
+        bound(&e);
+        return e;
+      });
       cells.pairs.removeDeadIfMany();  // the walk's drops
       cells.pairs.mergeTailIfLong();
       cells.quiet = obs_.empty() ? cells.quiet + 1 : 0;
@@ -207,6 +207,10 @@ class HitBlockUpdate {
   // (ranges come in ascending order).
   template <typename F>
   void inRange(std::uint32_t c0, std::uint32_t c1, F f) {
+    // Most ranges hold no hit cell: one test for both runs.
+    const std::uint32_t next1 = at1_ != end1_ ? at1_->code : ~0u;
+    const std::uint32_t next2 = at2_ != end2_ ? at2_->code : ~0u;
+    if (std::min(next1, next2) >= c1) return;
     at1_ = skipTo(at1_, end1_, c0);
     for (; at1_ != end1_ && at1_->code < c1; ++at1_) f(at1_);
     at2_ = skipTo(at2_, end2_, c0);
@@ -228,6 +232,18 @@ class HitBlockUpdate {
       lo = hi;
       step *= 2;
     }
+  }
+  // Pairs: a hit on the cell of entry x (live or dead), of log-odds `before` before the scan.
+  void hit(HitPair* x, double before) {
+    if (!x->live()) {
+      std::uint32_t lx, ly;
+      mortonCell(x->code, &lx, &ly);
+      x->h = 0.0f;
+      x->m = static_cast<float>(std::max(0.0, unhitMissesAt(ix0_ + lx, iy0_ + ly, before)));
+      --runs_->dead;
+    }
+    x->h += 1.0f;
+    bound(x);
   }
   // Pairs: the total of hits and misses bounded, keeping their ratio.
   void bound(HitPair* x) const {
