@@ -143,11 +143,6 @@ class Integrator {
   void emptySlot() {
     slot_span_.forEach([this](NdtEntry* x) { ndt_->forget(x); });
   }
-  // The code of the finest cell (ix, iy) within its block.
-  std::uint32_t codeOf(std::int64_t ix, std::int64_t iy) const {
-    return mortonCode(static_cast<std::uint32_t>(ix & cell_mask_),
-                      static_cast<std::uint32_t>(iy & cell_mask_));
-  }
 
   // The multiplicative part of an E update of a fully known subtree with forgetting: a lazy tag
   // (ALGORITHM.md 6.3; the additive part reaches the parent through the average), or eagerly.
@@ -165,6 +160,7 @@ class Integrator {
   // folds their average changes into n's details with one forward Haar step.
   double visitNode(Node& n, const SquareInfo& box, int l, std::int64_t ix0, std::int64_t iy0,
                    double s) {
+    [[maybe_unused]] const std::uint32_t code = slot_code_;  // kMissCursor: its first cell
     ++visited_;
     impl_.flush(n);
     // The children are read after the (long) classification: fetch them meanwhile.
@@ -184,7 +180,9 @@ class Integrator {
       if (child_box.cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
       if constexpr (kSpans) enterSlot(parts[qu], child_box);
-      if constexpr (kMissCursor) enterCells(codeOf(cx, cy), l - 1, child_box);
+      if constexpr (kMissCursor) {
+        enterCells(code + (static_cast<std::uint32_t>(q) << (2 * (l - 1))), l - 1, child_box);
+      }
       delta[qu] = updateSlot(slot, child_box.cls, c[qu], [&](Node& m) {
         return visitNode(m, child_box, l - 1, cx, cy, c[qu]);
       });
@@ -254,6 +252,7 @@ class Integrator {
   // class of its 4 cells, exactly, instead of a conservative square test of its own.
   [[gnu::noinline]] double visitLevel2(Node& n, const SquareInfo& box, std::int64_t ix0,
                                        std::int64_t iy0, double s) {
+    [[maybe_unused]] const std::uint32_t code = slot_code_;   // kMissCursor: its first cell
     const CellMasks cells = cls_.classify4x4(ix0, iy0, box);  // cell (x, y) at bit x + 4 y
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
@@ -269,9 +268,7 @@ class Integrator {
       if (cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
       if constexpr (kSpans) enterSlot(parts[qu], box);
-      if constexpr (kMissCursor) {
-        enterCells(codeOf(ix0 + (q & 1) * 2, iy0 + (q >> 1) * 2), 1, box);
-      }
+      if constexpr (kMissCursor) enterCells(code + (static_cast<std::uint32_t>(q) << 2), 1, box);
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
