@@ -12,6 +12,25 @@
 namespace wavog {
 namespace detail {
 
+/// The first entry of [b, e) (ascending by code) whose code is not below `code`: steps of 1, 2,
+/// 4, ... from b, then a binary search in the last one (cheap when it is near b).
+template <typename Entry>
+Entry* gallop(Entry* b, Entry* e, std::uint32_t code) {
+  std::size_t step = 1;
+  Entry* lo = b;
+  while (lo != e && lo->code < code) {
+    const auto left = static_cast<std::size_t>(e - lo);
+    Entry* hi = lo + std::min(step, left);
+    if (hi == e || hi->code >= code) {
+      return std::lower_bound(lo, hi, code,
+                              [](const Entry& x, std::uint32_t c) { return x.code < c; });
+    }
+    lo = hi;
+    step *= 2;
+  }
+  return lo;
+}
+
 /// The entries of one block's finest cells that hold a payload (Entry: a u32 `code`, `live()`,
 /// `kill()`; a value-initialised Entry is dead): two runs ascending by code, entries [0, sorted)
 /// and the short tail after them that takes new cells (merged into the first run when it outgrows
@@ -153,23 +172,6 @@ struct CellRuns {
 
   std::size_t added_ = 0;  // entries the last upsertSorted() added
 
-  // The first entry of [b, e) (ascending) whose code is not below `code`: steps of 1, 2, 4, ...
-  // from b, then a binary search in the last one.
-  static Entry* gallop(Entry* b, Entry* e, std::uint32_t code) {
-    std::size_t step = 1;
-    Entry* lo = b;
-    while (lo != e && lo->code < code) {
-      const auto left = static_cast<std::size_t>(e - lo);
-      Entry* hi = lo + std::min(step, left);
-      if (hi == e || hi->code >= code) {
-        return std::lower_bound(lo, hi, code,
-                                [](const Entry& x, std::uint32_t c) { return x.code < c; });
-      }
-      lo = hi;
-      step *= 2;
-    }
-    return lo;
-  }
   // The entry of `code` in [b, e), or nullptr; `at`: where it is or would be.
   static Entry* findIn(Entry* b, Entry* e, std::uint32_t code, Entry** at = nullptr) {
     Entry* it =

@@ -211,27 +211,10 @@ class HitBlockUpdate {
     const std::uint32_t next1 = at1_ != end1_ ? at1_->code : ~0u;
     const std::uint32_t next2 = at2_ != end2_ ? at2_->code : ~0u;
     if (std::min(next1, next2) >= c1) return;
-    at1_ = skipTo(at1_, end1_, c0);
+    at1_ = gallop(at1_, end1_, c0);
     for (; at1_ != end1_ && at1_->code < c1; ++at1_) f(at1_);
-    at2_ = skipTo(at2_, end2_, c0);
+    at2_ = gallop(at2_, end2_, c0);
     for (; at2_ != end2_ && at2_->code < c1; ++at2_) f(at2_);
-  }
-  // The first entry of [b, e) (ascending) whose code is not below `code`: steps of 1, 2, 4, ...
-  // from b, then a binary search in the last one.
-  static HitPair* skipTo(HitPair* b, HitPair* e, std::uint32_t code) {
-    if (b == e || b->code >= code) return b;
-    std::size_t step = 1;
-    HitPair* lo = b;
-    for (;;) {
-      const auto left = static_cast<std::size_t>(e - lo);
-      HitPair* hi = lo + std::min(step, left);
-      if (hi == e || hi->code >= code) {
-        return std::lower_bound(lo, hi, code,
-                                [](const HitPair& x, std::uint32_t c) { return x.code < c; });
-      }
-      lo = hi;
-      step *= 2;
-    }
   }
   // Pairs: a hit on the cell of entry x (live or dead), of log-odds `before` before the scan.
   void hit(HitPair* x, double before) {
