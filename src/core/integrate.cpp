@@ -175,13 +175,11 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     hit_consts.pairs = detail::boundsCounts(P);
     hit_consts.a = a;
     hit_consts.g = g;
-    hit_consts.bound = detail::countBound(p);
-    if (P == PolicyType::kClamp || P == PolicyType::kClampLower) {
-      hit_consts.empty_bound = p.policy.clamp_min;
+    if constexpr (detail::boundsCounts(P)) {
+      hit_consts.bound = detail::countBound(p);
+      hit_consts.empty_bound = detail::emptyBound(p);
     }
     hit_consts.basis = impl.reflection_basis;
-    if (impl.reflection_mode == ReflectionMode::kCounts)
-      hit_consts.misses_layer = impl.misses_layer.get();
     hits = &hit_consts;
   }
   st->blocks_touched = static_cast<std::uint32_t>(jobs.size());

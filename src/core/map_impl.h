@@ -74,6 +74,14 @@ struct WaveletMap::Impl {
   ReflectionMode reflection_mode = ReflectionMode::kOff;
   detail::ReflectionBasis reflection_basis;
   std::unique_ptr<WaveletMap> hits_layer, misses_layer;
+  /// The clamps (boundsCounts): the misses of cell (ix, iy), of log-odds `l`, as if it were
+  /// never hit: from misses_layer after a restart (kCounts), else from `l` (reflection.cpp).
+  double unhitMisses(std::int64_t ix, std::int64_t iy, double l) const {
+    if (reflection_mode == ReflectionMode::kCounts) {
+      return static_cast<double>(misses_layer->value({ix, iy}));
+    }
+    return reflection_basis.missesOfUnhit(l);
+  }
   std::size_t nodes = 0;  ///< live nodes (roots included)
   std::uint64_t nodes_visited_last = 0;
 

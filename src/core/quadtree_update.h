@@ -4,8 +4,8 @@
 // into the parent's details with one forward Haar step. With kNdt (MapParams::ndt and "forget")
 // the walk also carries the span of the block's Gaussians under each square and forgets those the
 // scan observes (ndt_update.h); with kHits (MapParams::reflection) it lists the occupied cells
-// and, under the clamps, carries the span of the block's hit cells and counts a miss on those in
-// free space (reflection_update.h). Not installed; included only by src/core/integrate*.cpp.
+// and, under the clamps, counts the misses and hits of the block's hit cells as it passes them
+// (reflection_update.h). Not installed; included only by src/core/integrate*.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 
@@ -26,25 +26,21 @@
 namespace wavog {
 namespace detail {
 
-/// The spans of a node's four children: without entries to carry, nothing (every child reads
-/// the empty span), so that the walk without them is the walk it always was.
-template <typename Span>
+/// The spans of a node's four children: without Gaussians, nothing (every child reads the empty
+/// span), so that the walk without them is the walk it always was.
 struct NoSpans {
-  const Span& operator[](std::size_t) const {
-    static const Span kNone{};
+  const NdtSpan& operator[](std::size_t) const {
+    static const NdtSpan kNone{};
     return kNone;
   }
 };
 
 template <PolicyType P, bool kNdt = false, bool kHits = false>
 class Integrator {
-  // The Gaussians the walk carries down ("forget" with kNdt); under the clamps (kHits), the hit
-  // cells it counts a miss on where the scan crosses them, met in code order by a cursor
-  // (HitBlockUpdate::missRange), since the walk visits the squares in code order.
-  static constexpr bool kSpans = kNdt;
+  using Spans = std::conditional_t<kNdt, std::array<NdtSpan, 4>, NoSpans>;
+  // Under the clamps (kHits), the walk meets the block's hit cells in code order, as it visits
+  // the squares, with HitBlockUpdate's cursor.
   static constexpr bool kMissCursor = kHits && boundsCounts(P);
-  using Span = NdtSpan;
-  using Spans = std::conditional_t<kSpans, std::array<Span, 4>, NoSpans<Span>>;
 
  public:
   /// Node groups come from and go to `store` (one Integrator per thread); with kNdt, the
@@ -65,13 +61,13 @@ class Integrator {
   /// Tree nodes and finest cells visited so far.
   std::uint64_t visited() const { return visited_; }
 
-  /// Updates block `b` (origin cell ix0, iy0) classified as `box`; `sp` spans the entries it
-  /// carries (kSpans).
+  /// Updates block `b` (origin cell ix0, iy0) classified as `box`; with kNdt, `sp` spans its
+  /// Gaussians.
   void integrateBlock(Block& b, std::int64_t ix0, std::int64_t iy0, const SquareInfo& box,
-                      const Span& sp = Span{}) {
+                      const NdtSpan& sp = NdtSpan{}) {
     RootSlot slot(impl_, store_, b);
     const double s = b.s;
-    if constexpr (kSpans) enterSlot(sp, box);
+    if constexpr (kNdt) enterSlot(sp, box);
     if constexpr (kMissCursor) enterCells(0, impl_.levels, box);
     b.s += updateSlot(slot, box.cls, s,
                       [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
@@ -81,7 +77,7 @@ class Integrator {
   // The rules of one slot of class `cls` whose average is s (U skipped, E at the slot's own
   // scale, the section 3.4 skip); descend(m) updates the slot's node m (the stored one, or a
   // temporary uniform one) when the slot must be refined, and returns the change of its average.
-  // With kSpans, slot_span_ spans the entries under the slot and slot_box_ is a square
+  // With kNdt, slot_span_ spans the Gaussians under the slot and slot_box_ is a square
   // classification holding it (for its cells' classes), set by enterSlot(). Returns the change of
   // the slot's average.
   template <typename Slot, typename Descend>
@@ -92,7 +88,7 @@ class Integrator {
         return 0.0;
       case CellClass::kEmpty:
         if (node == nullptr) {  // uniform block: exact for every policy
-          if constexpr (kSpans) emptySlot();
+          if constexpr (kNdt) forgetSlot();
           if constexpr (kMissCursor) {
             hits_->missRange(slot_code_, slot_level_, applyPolicy<P>(pc_, CellClass::kEmpty, s));
           }
@@ -100,7 +96,7 @@ class Integrator {
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
         }
         if (kAffineEmpty<P> && node->known_all == 0xF) {
-          if constexpr (kSpans) emptySlot();
+          if constexpr (kNdt) forgetSlot();
           if constexpr (kMissCursor) {  // clamp_upper, which has no empty bound
             hits_->missRange(slot_code_, slot_level_, std::numeric_limits<double>::quiet_NaN());
           }
@@ -127,8 +123,8 @@ class Integrator {
     return refineSlot(slot, node, descend);
   }
 
-  // kSpans: the next slot to update spans `sp`, inside the square classified as `box`.
-  void enterSlot(const Span& sp, const SquareInfo& box) {
+  // kNdt: the next slot to update spans `sp`, inside the square classified as `box`.
+  void enterSlot(const NdtSpan& sp, const SquareInfo& box) {
     slot_span_ = sp;
     slot_box_ = &box;
   }
@@ -139,8 +135,8 @@ class Integrator {
     slot_level_ = level;
     slot_box_ = &box;
   }
-  // kSpans: every cell of the slot is E.
-  void emptySlot() {
+  // kNdt: the scan observes every cell of the slot.
+  void forgetSlot() {
     slot_span_.forEach([this](NdtEntry* x) { ndt_->forget(x); });
   }
 
@@ -170,7 +166,7 @@ class Integrator {
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     Spans parts{};
-    if constexpr (kSpans) slot_span_.split(l, parts.data());
+    if constexpr (kNdt) slot_span_.split(l, parts.data());
     const std::int64_t half = std::int64_t{1} << (l - 1);
     for (int q = 0; q < 4; ++q) {
       const auto qu = static_cast<std::size_t>(q);
@@ -179,7 +175,7 @@ class Integrator {
       ++visited_;
       if (child_box.cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
-      if constexpr (kSpans) enterSlot(parts[qu], child_box);
+      if constexpr (kNdt) enterSlot(parts[qu], child_box);
       if constexpr (kMissCursor) {
         enterCells(code + (static_cast<std::uint32_t>(q) << (2 * (l - 1))), l - 1, child_box);
       }
@@ -257,7 +253,7 @@ class Integrator {
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     Spans parts{};
-    if constexpr (kSpans) slot_span_.split(2, parts.data());
+    if constexpr (kNdt) slot_span_.split(2, parts.data());
     for (int q = 0; q < 4; ++q) {
       ++visited_;
       const auto qu = static_cast<std::size_t>(q);
@@ -267,7 +263,7 @@ class Integrator {
       const CellClass cls = slotClass(cc);
       if (cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
-      if constexpr (kSpans) enterSlot(parts[qu], box);
+      if constexpr (kNdt) enterSlot(parts[qu], box);
       if constexpr (kMissCursor) enterCells(code + (static_cast<std::uint32_t>(q) << 2), 1, box);
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
@@ -308,9 +304,9 @@ class Integrator {
   HitBlockUpdate* const hits_;
   std::vector<HitObservation>* const observed_;
   const std::int64_t cell_mask_;  // a finest cell's index within its block
-  // kSpans: the entries under the slot being updated and a classification holding it (kSpans,
-  // kMissCursor). A visit reads them on entry (children set them again, one after the other).
-  Span slot_span_;
+  // kNdt: the Gaussians under the slot being updated; kNdt, kMissCursor: a classification holding
+  // it. A visit reads them on entry (children set them again, one after the other).
+  NdtSpan slot_span_;
   const SquareInfo* slot_box_ = nullptr;
   // kMissCursor: the codes of the slot being updated, [slot_code_, slot_code_ + 4^slot_level_).
   std::uint32_t slot_code_ = 0;

@@ -35,12 +35,14 @@ MapParams WaveletMap::Impl::layerParams(const MapParams& main, bool hits, Reflec
   p.sensor.odd_occ = hits ? 1.0 : 0.0;
   p.sensor.odd_emp = hits ? 0.0 : 1.0;
   if (!hits && mode == ReflectionMode::kCounts && detail::boundsCounts(main.policy.type)) {
-    // The clamps' misses of cells never hit, bounded as their counts are (countBound): counted
-    // down, as -m, so that "clamp_lower" bounds them where the bound is finite.
+    // The clamps' misses of cells never hit, bounded as their counts are (countBound) where the
+    // bound is finite ("clamp" to [0, bound]: counts never fall, the lower bound never acts).
     const double bound = detail::countBound(main);
-    p.policy.type = std::isinf(bound) ? PolicyType::kNone : PolicyType::kClampLower;
-    p.policy.clamp_min = std::isinf(bound) ? main.policy.clamp_min : -bound;
-    p.sensor.odd_emp = -1.0;
+    if (!std::isinf(bound)) {
+      p.policy.type = PolicyType::kClamp;
+      p.policy.clamp_min = 0.0;
+      p.policy.clamp_max = bound;
+    }
   }
   return p;
 }
@@ -147,15 +149,6 @@ double hitsOf(const WaveletMap::Impl&, const detail::HitPair& e, std::int64_t, s
   return static_cast<double>(e.h);
 }
 
-// The clamps: the misses of cell (ix, iy) as if it were never hit (from the misses layer, which
-// holds -m, after a restart; else from the occupancy).
-double unhitMisses(const WaveletMap::Impl& impl, std::int64_t ix, std::int64_t iy) {
-  if (impl.reflection_mode == ReflectionMode::kCounts) {
-    return -static_cast<double>(impl.misses_layer->value({ix, iy}));
-  }
-  return impl.reflection_basis.missesOfUnhit(impl.read(0, ix, iy).average);
-}
-
 // Per scale-s cell of a window, row-major: the mean hits of its cells, and under the clamps the
 // mean of what the entries' misses add to those the cells read as never hit.
 struct HitSums {
@@ -178,7 +171,8 @@ void addHits(const WaveletMap::Impl& impl, const detail::CellRuns<Entry>& runs, 
         static_cast<std::size_t>((ry - window.min_y) * window.width() + (rx - window.min_x));
     sums->h[k] += hitsOf(impl, e, ix, iy);
     if constexpr (std::is_same_v<Entry, detail::HitPair>) {
-      sums->dm[k] += static_cast<double>(e.m) - unhitMisses(impl, ix, iy);
+      sums->dm[k] +=
+          static_cast<double>(e.m) - impl.unhitMisses(ix, iy, impl.read(0, ix, iy).average);
     }
   }
 }
@@ -222,7 +216,7 @@ float fromCounts(const WaveletMap::Impl& impl, double l, double h, double m, dou
       return probability(prior_h, 1.0 - prior_h);
     }
     case ReflectionMode::kCounts:
-      return pairs ? probability(h, dm - m) : probability(h, m);
+      return probability(h, m + (pairs ? dm : 0.0));
     case ReflectionMode::kLayers:
       return probability(l, m);
     case ReflectionMode::kOff:
@@ -293,8 +287,7 @@ float WaveletMap::reflection(const CellIndex& cell) const {
     }
     if (const detail::HitPair* e = b->hits->pairs.find(code); e != nullptr && e->live()) {
       h = e->h;
-      dm = static_cast<double>(e->m) -
-           (counted_misses ? -m : impl.reflection_basis.missesOfUnhit(l));
+      dm = static_cast<double>(e->m) - impl.unhitMisses(cell.x, cell.y, l);
     }
   }
   return fromCounts(impl, l, h, m, dm);

@@ -76,6 +76,13 @@ inline double countBound(const MapParams& p) {
   return p.policy.clamp_min / p.sensor.odd_emp;
 }
 
+/// The clamps: the occupancy's empty bound, at which a hit cell forgets its hits (clamp_min for
+/// "clamp" and "clamp_lower"; none, -inf, for "clamp_upper").
+inline double emptyBound(const MapParams& p) {
+  if (p.policy.type == PolicyType::kClampUpper) return -std::numeric_limits<double>::infinity();
+  return p.policy.clamp_min;
+}
+
 /// Log-odds above clamp_min within which a cell's occupancy counts as at its empty bound (float
 /// round-off of the tree's coefficients; the clamps' reflection map resets the cell there).
 constexpr double kAtEmptyBound = 1e-5;

@@ -24,28 +24,27 @@ namespace wavog {
 namespace detail {
 
 /// What a scan does to the hits: count, or (ratios) forget by a = 1 - g with a hit weighing g,
-/// or (pairs) count hits and misses with their total bounded at `bound`; the misses of a cell
-/// never hit are read from `misses_layer` (a restart, kCounts: it holds -m) or from the
-/// occupancy.
+/// or (pairs) count hits and misses with their total bounded at `bound`, reset at the
+/// occupancy's `empty_bound` (countBound, emptyBound).
 struct HitConsts {
   bool ratios = false;
   bool pairs = false;
   double a = 1.0, g = 0.0;
   double bound = 0.0;
-  double empty_bound = -std::numeric_limits<double>::infinity();  // clamp_min, if the policy has it
+  double empty_bound = -std::numeric_limits<double>::infinity();
   ReflectionBasis basis;
-  const WaveletMap* misses_layer = nullptr;
 };
-
-/// The span of a block's hit pairs (cell_runs.h).
-using HitSpan = CellSpan<HitPair>;
 
 /// The hits of one block for one scan: observations() is filled by the walk of the block, then
 /// finish() applies them.
 class HitBlockUpdate {
  public:
   HitBlockUpdate(const WaveletMap::Impl& impl, const ScanClassifier& cls, const HitConsts& c)
-      : impl_(impl), cls_(cls), c_(c), bound_(static_cast<float>(c.bound)) {}
+      : impl_(impl),
+        cls_(cls),
+        c_(c),
+        bound_(static_cast<float>(c.bound)),
+        counted_misses_(impl.reflection_mode == ReflectionMode::kCounts) {}
 
   std::vector<HitObservation>* observations() { return &obs_; }
 
@@ -56,11 +55,7 @@ class HitBlockUpdate {
     ix0_ = ix0;
     iy0_ = iy0;
     runs_ = b.hits ? &b.hits->pairs : nullptr;
-    const HitSpan all = b.hits ? spanOf(&b.hits->pairs) : HitSpan{};
-    at1_ = all.b1;
-    end1_ = all.e1;
-    at2_ = all.b2;
-    end2_ = all.e2;
+    ahead_ = b.hits ? spanOf(&b.hits->pairs) : CellSpan<HitPair>{};
   }
   /// Pairs: every cell of codes [code, code + 4^level) is E, of log-odds `after` after the scan.
   void missRange(std::uint32_t code, int level, double after) {
@@ -105,7 +100,7 @@ class HitBlockUpdate {
     if (apply && after <= c_.empty_bound + kAtEmptyBound) {
       // At the occupancy's empty bound: no hits, a full count of misses, which is what the cell
       // reads without an entry (l / odd_emp = bound) unless the misses are a restart's layer.
-      if (c_.misses_layer == nullptr) {
+      if (!counted_misses_) {
         runs_->drop(x);
       } else {
         x->h = 0.0f;
@@ -146,28 +141,20 @@ class HitBlockUpdate {
           });
       cells.ratios.mergeTailIfLong();
       // Sweep now and then, and soon when the block's hits stop (its cells then fade fast).
-      cells.quiet = obs_.empty() ? cells.quiet + 1 : 0;
-      if (++cells.scans >= kSweepScans || cells.quiet == kQuietScans) {
-        cells.scans = 0;
-        sweep(&cells.ratios, ix0, iy0);
-      }
+      if (sweepDue(&cells)) sweep(&cells.ratios, ix0, iy0);
     } else if (c_.pairs) {
       // The walk counted the cells with an entry (visitCells): these are new.
       cells.pairs.insertNewSorted(first, last, [this, ix0, iy0](const HitObservation& o) {
         HitPair e;
         e.code = o.code;
         e.h = 1.0f;
-        e.m = static_cast<float>(unhitMisses(o, ix0, iy0));
+        e.m = static_cast<float>(unhitMisses(o.code, ix0, iy0, o.before));
         bound(&e);
         return e;
       });
       cells.pairs.removeDeadIfMany();  // the walk's drops
       cells.pairs.mergeTailIfLong();
-      cells.quiet = obs_.empty() ? cells.quiet + 1 : 0;
-      if (++cells.scans >= kSweepScans || cells.quiet == kQuietScans) {
-        cells.scans = 0;
-        sweepPairs(&cells.pairs, ix0, iy0);
-      }
+      if (sweepDue(&cells)) sweepPairs(&cells.pairs, ix0, iy0);
     } else {
       cells.counts.upsertSorted(
           first, last,
@@ -208,21 +195,21 @@ class HitBlockUpdate {
   template <typename F>
   void inRange(std::uint32_t c0, std::uint32_t c1, F f) {
     // Most ranges hold no hit cell: one test for both runs.
-    const std::uint32_t next1 = at1_ != end1_ ? at1_->code : ~0u;
-    const std::uint32_t next2 = at2_ != end2_ ? at2_->code : ~0u;
+    CellSpan<HitPair>& a = ahead_;
+    const std::uint32_t next1 = a.b1 != a.e1 ? a.b1->code : ~0u;
+    const std::uint32_t next2 = a.b2 != a.e2 ? a.b2->code : ~0u;
     if (std::min(next1, next2) >= c1) return;
-    at1_ = gallop(at1_, end1_, c0);
-    for (; at1_ != end1_ && at1_->code < c1; ++at1_) f(at1_);
-    at2_ = gallop(at2_, end2_, c0);
-    for (; at2_ != end2_ && at2_->code < c1; ++at2_) f(at2_);
+    // (The cursors are mostly at c0 already: gallop only past cells of squares not visited.)
+    if (next1 < c0) a.b1 = gallop(a.b1, a.e1, c0);
+    for (; a.b1 != a.e1 && a.b1->code < c1; ++a.b1) f(a.b1);
+    if (next2 < c0) a.b2 = gallop(a.b2, a.e2, c0);
+    for (; a.b2 != a.e2 && a.b2->code < c1; ++a.b2) f(a.b2);
   }
   // Pairs: a hit on the cell of entry x (live or dead), of log-odds `before` before the scan.
   void hit(HitPair* x, double before) {
     if (!x->live()) {
-      std::uint32_t lx, ly;
-      mortonCell(x->code, &lx, &ly);
       x->h = 0.0f;
-      x->m = static_cast<float>(std::max(0.0, unhitMissesAt(ix0_ + lx, iy0_ + ly, before)));
+      x->m = static_cast<float>(unhitMisses(x->code, ix0_, iy0_, before));
       --runs_->dead;
     }
     x->h += 1.0f;
@@ -234,17 +221,20 @@ class HitBlockUpdate {
     x->h *= f;
     x->m *= f;
   }
-  // Pairs: the misses of the cell (ix, iy) as if it were never hit: from the misses layer after a
-  // restart, else from its log-odds `l`.
-  double unhitMissesAt(std::int64_t ix, std::int64_t iy, double l) const {
-    if (c_.misses_layer != nullptr) return -static_cast<double>(c_.misses_layer->value({ix, iy}));
-    return c_.basis.missesOfUnhit(l);
-  }
-  // (At least 0: the occupancy's float round-off may leave a hair above the prior.)
-  double unhitMisses(const HitObservation& o, std::int64_t ix0, std::int64_t iy0) const {
+  // Pairs: the misses of the cell of `code` (log-odds `l`) as if it were never hit, at least 0
+  // (the occupancy's float round-off may leave a hair above the prior).
+  double unhitMisses(std::uint32_t code, std::int64_t ix0, std::int64_t iy0, double l) const {
     std::uint32_t lx, ly;
-    mortonCell(o.code, &lx, &ly);
-    return std::max(0.0, unhitMissesAt(ix0 + lx, iy0 + ly, o.before));
+    mortonCell(code, &lx, &ly);
+    return std::max(0.0, impl_.unhitMisses(ix0 + lx, iy0 + ly, l));
+  }
+  // Counts an integration of the block of `cells`; true when its faded entries are due a sweep:
+  // every kSweepScans, and soon when its hits stop (its cells then fade fast).
+  bool sweepDue(HitCells* cells) const {
+    cells->quiet = obs_.empty() ? cells->quiet + 1 : 0;
+    if (++cells->scans < kSweepScans && cells->quiet != kQuietScans) return false;
+    cells->scans = 0;
+    return true;
   }
   // Pairs: drops the entries whose hits have faded to a kFadedHits share of their count and whose
   // misses are those the cell reads without an entry (to kFadedHits of the bound), so that the
@@ -258,7 +248,7 @@ class HitBlockUpdate {
       mortonCell(e.code, &lx, &ly);
       const std::int64_t ix = ix0 + lx, iy = iy0 + ly;
       const double unhit =
-          unhitMissesAt(ix, iy, c_.misses_layer ? 0.0 : impl_.read(0, ix, iy).average);
+          impl_.unhitMisses(ix, iy, counted_misses_ ? 0.0 : impl_.read(0, ix, iy).average);
       if (std::fabs(unhit - m) <= kFadedHits * std::max(1.0, m)) runs->drop(&e);
     }
     runs->removeDeadIfMany();
@@ -279,11 +269,12 @@ class HitBlockUpdate {
   const WaveletMap::Impl& impl_;
   const ScanClassifier& cls_;
   const HitConsts c_;
-  const float bound_;  // c_.bound
+  const float bound_;          // c_.bound
+  const bool counted_misses_;  // the misses of cells never hit are a restart's layer (kCounts)
   std::vector<HitObservation> obs_;
   std::int64_t ix0_ = 0, iy0_ = 0;     // pairs: the block begin() started
-  CellRuns<HitPair>* runs_ = nullptr;  // and its entries: the walk's cursors in their two runs
-  HitPair *at1_ = nullptr, *end1_ = nullptr, *at2_ = nullptr, *end2_ = nullptr;
+  CellRuns<HitPair>* runs_ = nullptr;  // and its entries
+  CellSpan<HitPair> ahead_;            // those the walk has not passed yet (its cursors)
 };
 
 }  // namespace detail
