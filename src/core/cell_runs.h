@@ -31,6 +31,24 @@ Entry* gallop(Entry* b, Entry* e, std::uint32_t code) {
   return lo;
 }
 
+/// The first entry of [b, e) (ascending by code) from which on every code is above `code`
+/// (std::upper_bound), searched from e back: steps of 1, 2, 4, ..., then a binary search.
+template <typename Entry>
+Entry* gallopBack(Entry* b, Entry* e, std::uint32_t code) {
+  std::size_t step = 1;
+  Entry* hi = e;  // [hi, e) are above `code`
+  while (hi != b) {
+    Entry* lo = hi - std::min(step, static_cast<std::size_t>(hi - b));
+    if (lo->code <= code) {
+      return std::upper_bound(lo, hi, code,
+                              [](std::uint32_t c, const Entry& x) { return c < x.code; });
+    }
+    hi = lo;
+    step *= 2;
+  }
+  return b;
+}
+
 /// The entries of one block's finest cells that hold a payload (Entry: a u32 `code`, `live()`,
 /// `kill()`; a value-initialised Entry is dead): two runs ascending by code, entries [0, sorted)
 /// and the short tail after them that takes new cells (merged into the first run when it outgrows
@@ -67,9 +85,11 @@ struct CellRuns {
   }
   /// For items [first, last) ascending by `code` (one per cell): update(entry, item) on the entry
   /// of each item's cell, live or dead (it must leave it live), or, when it has none, a new
-  /// entry make(item) (live); new entries join the tail as one sorted batch.
-  template <typename Item, typename Update, typename Make>
-  void upsertSorted(const Item* first, const Item* last, Update update, Make make) {
+  /// entry make(item) (live); new entries join the tail as one sorted batch. Cells for which
+  /// may_have(code) is false have no entry (they are not searched).
+  template <typename Item, typename Update, typename Make, typename MayHave>
+  void upsertSorted(const Item* first, const Item* last, Update update, Make make,
+                    MayHave may_have) {
     const std::size_t old_size = entries.size();
     const auto items = static_cast<std::size_t>(last - first);
     reserveFor(items);  // room for every item: no pointer below moves
@@ -80,6 +100,10 @@ struct CellRuns {
     Entry* in_run = entries.data();
     Entry* in_tail = run_end;
     for (const Item* it = first; it != last; ++it) {
+      if (!may_have(it->code)) {
+        entries.push_back(make(*it));
+        continue;
+      }
       in_run = gallop(in_run, run_end, it->code);
       Entry* e = in_run != run_end && in_run->code == it->code ? in_run : nullptr;
       if (e == nullptr) {
@@ -107,20 +131,7 @@ struct CellRuns {
   /// Merges the entries from `old_size` on (new, ascending) into the tail.
   void mergeAdded(std::size_t old_size) {
     added_ = entries.size() - old_size;
-    if (added_ == 0) return;
-    // The new entries into the tail, from the back: each entry moves once.
-    thread_local std::vector<Entry> added;  // reused from call to call
-    added.assign(entries.begin() + static_cast<std::ptrdiff_t>(old_size), entries.end());
-    Entry* out = entries.data() + entries.size();
-    Entry* t = entries.data() + old_size;  // one past the old tail's last entry
-    Entry* const t_begin = entries.data() + sorted;
-    for (std::size_t a = added.size(); a > 0;) {
-      if (t != t_begin && t[-1].code > added[a - 1].code) {
-        *--out = *--t;
-      } else {
-        *--out = added[--a];
-      }
-    }
+    mergeBack(sorted, old_size);
   }
   /// Merges the tail into the first run when it is longer than kTail and 2 sqrt(sorted k), k the
   /// entries the last upsertSorted() added (1 for single inserts): with k new entries at a time,
@@ -130,9 +141,7 @@ struct CellRuns {
     const std::size_t k = std::max<std::size_t>(1, added_);
     added_ = 0;
     if (tail <= kTail || tail * tail <= 4 * sorted * k) return;
-    const auto by_code = [](const Entry& a, const Entry& b) { return a.code < b.code; };
-    std::inplace_merge(entries.begin(), entries.begin() + static_cast<std::ptrdiff_t>(sorted),
-                       entries.end(), by_code);
+    mergeBack(0, sorted);
     sorted = entries.size();
   }
   /// Drops the payload of `e` (a live entry).
@@ -171,6 +180,24 @@ struct CellRuns {
   }
 
   std::size_t added_ = 0;  // entries the last upsertSorted() added
+
+  // Merges the entries [mid, end), ascending, into [begin, mid), ascending, from the back: the
+  // entries of [begin, mid) move once, in blocks (found by gallopBack(): what a scan adds comes in
+  // clusters), through a buffer kept from call to call for those of [mid, end).
+  void mergeBack(std::size_t begin, std::size_t mid) {
+    if (mid == entries.size()) return;
+    thread_local std::vector<Entry> moving;
+    moving.assign(entries.begin() + static_cast<std::ptrdiff_t>(mid), entries.end());
+    Entry* out = entries.data() + entries.size();
+    Entry* t = entries.data() + mid;  // one past the entries of [begin, mid) not yet moved
+    Entry* const t_begin = entries.data() + begin;
+    for (std::size_t a = moving.size(); a > 0; --a) {
+      Entry* const above = gallopBack(t_begin, t, moving[a - 1].code);
+      out = std::move_backward(above, t, out);
+      t = above;
+      *--out = moving[a - 1];
+    }
+  }
 
   // The entry of `code` in [b, e), or nullptr; `at`: where it is or would be.
   static Entry* findIn(Entry* b, Entry* e, std::uint32_t code, Entry** at = nullptr) {

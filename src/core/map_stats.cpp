@@ -40,7 +40,7 @@ MapStats WaveletMap::stats(bool count_observed) const {
     hit_bytes += sizeof(detail::HitCells) +
                  hits->counts.entries.capacity() * sizeof(detail::HitCount) +
                  hits->ratios.entries.capacity() * sizeof(detail::HitRatio) +
-                 hits->pairs.entries.capacity() * sizeof(detail::HitPair);
+                 hits->pairs.entries.capacity() * sizeof(detail::HitPair) + hits->bits.bytes();
   }
   st.reflection_bytes = hit_bytes;
   for (const auto& kv : impl.blocks) {

@@ -55,8 +55,7 @@ class Integrator {
         lazy_(impl.params.lazy_forgetting),
         ndt_(ndt),
         hits_(hits),
-        observed_(hits != nullptr ? hits->observations() : nullptr),
-        cell_mask_((std::int64_t{1} << impl.levels) - 1) {}
+        observed_(hits != nullptr ? hits->observations() : nullptr) {}
 
   /// Tree nodes and finest cells visited so far.
   std::uint64_t visited() const { return visited_; }
@@ -68,7 +67,7 @@ class Integrator {
     RootSlot slot(impl_, store_, b);
     const double s = b.s;
     if constexpr (kNdt) enterSlot(sp, box);
-    if constexpr (kMissCursor) enterCells(0, impl_.levels, box);
+    if constexpr (kHits) enterCells(0, impl_.levels, box);
     b.s += updateSlot(slot, box.cls, s,
                       [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
   }
@@ -128,8 +127,8 @@ class Integrator {
     slot_span_ = sp;
     slot_box_ = &box;
   }
-  // kMissCursor: the next slot to update holds the cells of codes [code, code + 4^level), inside
-  // the square classified as `box`.
+  // kHits: the next slot to update holds the cells of codes [code, code + 4^level), inside the
+  // square classified as `box`.
   void enterCells(std::uint32_t code, int level, const SquareInfo& box) {
     slot_code_ = code;
     slot_level_ = level;
@@ -156,7 +155,7 @@ class Integrator {
   // folds their average changes into n's details with one forward Haar step.
   double visitNode(Node& n, const SquareInfo& box, int l, std::int64_t ix0, std::int64_t iy0,
                    double s) {
-    [[maybe_unused]] const std::uint32_t code = slot_code_;  // kMissCursor: its first cell
+    [[maybe_unused]] const std::uint32_t code = slot_code_;  // kHits: its first cell
     ++visited_;
     impl_.flush(n);
     // The children are read after the (long) classification: fetch them meanwhile.
@@ -176,7 +175,7 @@ class Integrator {
       if (child_box.cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
       if constexpr (kNdt) enterSlot(parts[qu], child_box);
-      if constexpr (kMissCursor) {
+      if constexpr (kHits) {
         enterCells(code + (static_cast<std::uint32_t>(q) << (2 * (l - 1))), l - 1, child_box);
       }
       delta[qu] = updateSlot(slot, child_box.cls, c[qu], [&](Node& m) {
@@ -196,15 +195,14 @@ class Integrator {
       cells.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << q;
       cells.o |= static_cast<std::uint32_t>(cls == CellClass::kOccupied) << q;
     }
-    return updateCells(n, cells, s, ix0, iy0);
+    return updateCells(n, cells, s);
   }
 
-  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed, origin
-  // cell ix0, iy0), cell q E or O by bit q of `cells` (U when in neither), and to the Gaussians
-  // of those cells (the slot's span); with kHits, lists its O cells; returns the change of n's
+  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), cell q
+  // E or O by bit q of `cells` (U when in neither), and to the Gaussians of those cells (the
+  // slot's span); with kHits, lists its O cells (codes slot_code_ + q); returns the change of n's
   // average.
-  double updateCells(Node& n, const CellMasks& cells, double s, std::int64_t ix0,
-                     std::int64_t iy0) {
+  double updateCells(Node& n, const CellMasks& cells, double s) {
     visited_ += 4;
     if constexpr (kNdt) {
       const std::uint32_t observed = cells.e | cells.o;
@@ -222,20 +220,15 @@ class Integrator {
       }
     }
     if constexpr (kHits) {
-      // Under the clamps the cells with an entry are counted on the way (slot_code_: this
-      // level-1 node's, entered by its parent); the other O cells are listed.
+      // slot_code_: this level-1 node's first cell, entered by its parent. Under the clamps the
+      // cells with an entry are counted on the way; the other O cells are listed.
       std::uint32_t listed = cells.o;
       if constexpr (kMissCursor)
         listed &= ~hits_->visitCells(slot_code_, cells.e, cells.o, c, delta);
       for (std::uint32_t o = listed; o != 0; o &= o - 1) {
         const auto q = static_cast<unsigned>(__builtin_ctz(o));
-        const auto lx = static_cast<std::uint32_t>((ix0 + (q & 1u)) & cell_mask_);
-        const auto ly = static_cast<std::uint32_t>((iy0 + (q >> 1)) & cell_mask_);
-        observed_->push_back({mortonCode(lx, ly), c[q]});
+        observed_->push_back({slot_code_ + q, c[q]});
       }
-    } else {
-      (void)ix0;
-      (void)iy0;
     }
     const auto known = static_cast<std::uint8_t>(cells.e | cells.o);
     n.known_all = (n.known_all | known) & 0xFu;  // 4-bit masks
@@ -248,7 +241,7 @@ class Integrator {
   // class of its 4 cells, exactly, instead of a conservative square test of its own.
   [[gnu::noinline]] double visitLevel2(Node& n, const SquareInfo& box, std::int64_t ix0,
                                        std::int64_t iy0, double s) {
-    [[maybe_unused]] const std::uint32_t code = slot_code_;   // kMissCursor: its first cell
+    [[maybe_unused]] const std::uint32_t code = slot_code_;   // kHits: its first cell
     const CellMasks cells = cls_.classify4x4(ix0, iy0, box);  // cell (x, y) at bit x + 4 y
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
@@ -264,11 +257,11 @@ class Integrator {
       if (cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
       if constexpr (kNdt) enterSlot(parts[qu], box);
-      if constexpr (kMissCursor) enterCells(code + (static_cast<std::uint32_t>(q) << 2), 1, box);
+      if constexpr (kHits) enterCells(code + (static_cast<std::uint32_t>(q) << 2), 1, box);
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
-        return updateCells(m, cc, c[qu], ix0 + (q & 1) * 2, iy0 + (q >> 1) * 2);
+        return updateCells(m, cc, c[qu]);
       });
     }
     return foldChanges(n, delta);
@@ -303,12 +296,10 @@ class Integrator {
   NdtBlockUpdate* const ndt_;
   HitBlockUpdate* const hits_;
   std::vector<HitObservation>* const observed_;
-  const std::int64_t cell_mask_;  // a finest cell's index within its block
-  // kNdt: the Gaussians under the slot being updated; kNdt, kMissCursor: a classification holding
-  // it. A visit reads them on entry (children set them again, one after the other).
+  // kNdt: the Gaussians under the slot being updated; kNdt, kHits: a classification holding it. A visit reads them on entry (children set them again, one after the other).
   NdtSpan slot_span_;
   const SquareInfo* slot_box_ = nullptr;
-  // kMissCursor: the codes of the slot being updated, [slot_code_, slot_code_ + 4^slot_level_).
+  // kHits: the codes of the slot being updated, [slot_code_, slot_code_ + 4^slot_level_).
   std::uint32_t slot_code_ = 0;
   int slot_level_ = 0;
   std::uint64_t visited_ = 0;

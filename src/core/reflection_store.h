@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "cell_runs.h"
 #include "wavog_mapping/core/params.h"
@@ -46,13 +47,49 @@ struct HitPair {
   void kill() { h = -1.0f; }
 };
 
-/// A block's hits: `counts`, `ratios` or `pairs`, by the map's policy. `scans`: integrations that
-/// met the block since its ratios were last swept of the cells whose hits have faded; `quiet`: the
-/// last of them in a row without a hit (reflection_update.h).
+/// One bit per finest cell of a block, set where one of its runs holds an entry (live or dead), so
+/// that a scan's hit on a cell whose bit is clear adds an entry without searching the runs (most
+/// hits of a moving scene are on new cells). The runs change elsewhere only by losing entries
+/// (sweeps, clearBox), so that they are in step while their size is the one last recorded, and
+/// else rebuilt.
+class CellBits {
+ public:
+  template <typename Entry>
+  bool inStep(const CellRuns<Entry>& runs) const {
+    return &runs == static_cast<const void*>(of_) && runs.entries.size() == size_;
+  }
+  bool test(std::uint32_t code) const { return ((words_[code >> 6] >> (code & 63u)) & 1u) != 0; }
+  void set(std::uint32_t code) { words_[code >> 6] |= std::uint64_t{1} << (code & 63u); }
+  /// The bits of the entries of `runs`, in a block of 4^levels cells.
+  template <typename Entry>
+  void rebuild(const CellRuns<Entry>& runs, int levels) {
+    words_.assign(std::max<std::size_t>(1, (std::size_t{1} << (2 * levels)) / 64), 0);
+    for (const Entry& e : runs.entries) set(e.code);
+    step(runs);
+  }
+  /// `runs`, after set() for each entry added to them, are in step.
+  template <typename Entry>
+  void step(const CellRuns<Entry>& runs) {
+    of_ = &runs;
+    size_ = runs.entries.size();
+  }
+  std::size_t bytes() const { return words_.capacity() * sizeof(std::uint64_t); }
+
+ private:
+  std::vector<std::uint64_t> words_;
+  const void* of_ = nullptr;  // the runs they are in step with, at `size_` entries
+  std::size_t size_ = 0;
+};
+
+/// A block's hits: `counts`, `ratios` or `pairs`, by the map's policy, with `bits` of the cells of
+/// counts or ratios. `scans`: integrations that met the block since its ratios were last swept of
+/// the cells whose hits have faded; `quiet`: the last of them in a row without a hit
+/// (reflection_update.h).
 struct HitCells {
   CellRuns<HitCount> counts;
   CellRuns<HitRatio> ratios;
   CellRuns<HitPair> pairs;
+  CellBits bits;
   std::uint32_t scans = 0, quiet = 0;
 
   bool empty() const { return counts.empty() && ratios.empty() && pairs.empty(); }

@@ -131,15 +131,14 @@ class HitBlockUpdate {
     const HitObservation* first = obs_.data();
     const HitObservation* last = first + obs_.size();
     if (c_.ratios) {
-      cells.ratios.upsertSorted(
-          first, last, [this](HitRatio& e, const HitObservation& o) { renew(&e, o); },
-          [this](const HitObservation& o) {
-            HitRatio e;
-            e.code = o.code;
-            renew(&e, o);
-            return e;
-          });
-      cells.ratios.mergeTailIfLong();
+      upsert(&cells.ratios, &cells.bits, first, last,
+             [this](HitRatio& e, const HitObservation& o) { renew(&e, o); },
+             [this](const HitObservation& o) {
+               HitRatio e;
+               e.code = o.code;
+               renew(&e, o);
+               return e;
+             });
       // Sweep now and then, and soon when the block's hits stop (its cells then fade fast).
       if (sweepDue(&cells)) sweep(&cells.ratios, ix0, iy0);
     } else if (c_.pairs) {
@@ -156,18 +155,16 @@ class HitBlockUpdate {
       cells.pairs.mergeTailIfLong();
       if (sweepDue(&cells)) sweepPairs(&cells.pairs, ix0, iy0);
     } else {
-      cells.counts.upsertSorted(
-          first, last,
-          [](HitCount& e, const HitObservation&) {
-            if (e.n != std::numeric_limits<std::uint32_t>::max()) ++e.n;
-          },
-          [](const HitObservation& o) {
-            HitCount e;
-            e.code = o.code;
-            e.n = 1;
-            return e;
-          });
-      cells.counts.mergeTailIfLong();
+      upsert(&cells.counts, &cells.bits, first, last,
+             [](HitCount& e, const HitObservation&) {
+               if (e.n != std::numeric_limits<std::uint32_t>::max()) ++e.n;
+             },
+             [](const HitObservation& o) {
+               HitCount e;
+               e.code = o.code;
+               e.n = 1;
+               return e;
+             });
     }
     obs_.clear();
   }
@@ -188,6 +185,23 @@ class HitBlockUpdate {
     }
     h = c_.a * h + c_.g;
     e->q = static_cast<float>(std::min(1.0, c_.a * never) / h);
+  }
+
+  // Counts or ratios: upsertSorted() of [first, last) into `runs`, searching only the cells that
+  // `bits` say have an entry.
+  template <typename Entry, typename Update, typename Make>
+  void upsert(CellRuns<Entry>* runs, CellBits* bits, const HitObservation* first,
+              const HitObservation* last, Update update, Make make) {
+    if (!bits->inStep(*runs)) bits->rebuild(*runs, impl_.levels);
+    runs->upsertSorted(
+        first, last, update,
+        [&](const HitObservation& o) {
+          bits->set(o.code);
+          return make(o);
+        },
+        [bits](std::uint32_t code) { return bits->test(code); });
+    bits->step(*runs);
+    runs->mergeTailIfLong();
   }
 
   // Pairs: f(x) on the entries of codes [c0, c1) of both runs, from where the last range ended
