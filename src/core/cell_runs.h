@@ -144,6 +144,12 @@ struct CellRuns {
     mergeBack(0, sorted);
     sorted = entries.size();
   }
+  /// Merges the tail into the first run.
+  void mergeTail() {
+    added_ = 0;
+    mergeBack(0, sorted);
+    sorted = entries.size();
+  }
   /// Drops the payload of `e` (a live entry).
   void drop(Entry* e) {
     e->kill();

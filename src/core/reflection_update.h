@@ -49,13 +49,19 @@ class HitBlockUpdate {
   std::vector<HitObservation>* observations() { return &obs_; }
 
   /// Pairs: starts block (origin cell ix0, iy0), whose walk then hands the squares and cells it
-  /// finds E to missRange(), missObservedRange() and missCells(), in code order (no entry is
+  /// finds E to missRange(), missObservedRange() and visitCells(), in code order (no entry is
   /// added or moved until finish()).
   void begin(Block& b, std::int64_t ix0, std::int64_t iy0) {
     ix0_ = ix0;
     iy0_ = iy0;
     runs_ = b.hits ? &b.hits->pairs : nullptr;
-    ahead_ = b.hits ? spanOf(&b.hits->pairs) : CellSpan<HitPair>{};
+    ahead_ = end_ = nullptr;
+    if (runs_ != nullptr) {
+      if (runs_->sorted != runs_->entries.size()) runs_->mergeTail();  // one run (a loaded file)
+      ahead_ = runs_->entries.data();
+      end_ = ahead_ + runs_->entries.size();
+    }
+    next_ = ahead_ != end_ ? ahead_->code : ~0u;
   }
   /// Pairs: every cell of codes [code, code + 4^level) is E, of log-odds `after` after the scan.
   void missRange(std::uint32_t code, int level, double after) {
@@ -152,7 +158,7 @@ class HitBlockUpdate {
         return e;
       });
       cells.pairs.removeDeadIfMany();  // the walk's drops
-      cells.pairs.mergeTailIfLong();
+      cells.pairs.mergeTail();         // one run for the next walk's cursor
       if (sweepDue(&cells)) sweepPairs(&cells.pairs, ix0, iy0);
     } else {
       upsert(&cells.counts, &cells.bits, first, last,
@@ -204,20 +210,16 @@ class HitBlockUpdate {
     runs->mergeTailIfLong();
   }
 
-  // Pairs: f(x) on the entries of codes [c0, c1) of both runs, from where the last range ended
-  // (ranges come in ascending order).
+  // Pairs: f(x) on the entries of codes [c0, c1), from where the last range ended (ranges come
+  // in ascending order).
   template <typename F>
   void inRange(std::uint32_t c0, std::uint32_t c1, F f) {
-    // Most ranges hold no hit cell: one test for both runs.
-    CellSpan<HitPair>& a = ahead_;
-    const std::uint32_t next1 = a.b1 != a.e1 ? a.b1->code : ~0u;
-    const std::uint32_t next2 = a.b2 != a.e2 ? a.b2->code : ~0u;
-    if (std::min(next1, next2) >= c1) return;
-    // (The cursors are mostly at c0 already: gallop only past cells of squares not visited.)
-    if (next1 < c0) a.b1 = gallop(a.b1, a.e1, c0);
-    for (; a.b1 != a.e1 && a.b1->code < c1; ++a.b1) f(a.b1);
-    if (next2 < c0) a.b2 = gallop(a.b2, a.e2, c0);
-    for (; a.b2 != a.e2 && a.b2->code < c1; ++a.b2) f(a.b2);
+    // Most ranges hold no hit cell: one test.
+    if (next_ >= c1) return;
+    // (The cursor is mostly at c0 already: gallop only past cells of squares not visited.)
+    if (next_ < c0) ahead_ = gallop(ahead_, end_, c0);
+    for (; ahead_ != end_ && ahead_->code < c1; ++ahead_) f(ahead_);
+    next_ = ahead_ != end_ ? ahead_->code : ~0u;
   }
   // Pairs: a hit on the cell of entry x (live or dead), of log-odds `before` before the scan.
   void hit(HitPair* x, double before) {
@@ -288,7 +290,9 @@ class HitBlockUpdate {
   std::vector<HitObservation> obs_;
   std::int64_t ix0_ = 0, iy0_ = 0;     // pairs: the block begin() started
   CellRuns<HitPair>* runs_ = nullptr;  // and its entries
-  CellSpan<HitPair> ahead_;            // those the walk has not passed yet (its cursors)
+  HitPair* ahead_ = nullptr;           // the first the walk has not passed yet (its cursor)
+  HitPair* end_ = nullptr;             // and their end
+  std::uint32_t next_ = ~0u;           // the cursor's code (~0u at the end)
 };
 
 }  // namespace detail
