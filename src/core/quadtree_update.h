@@ -195,14 +195,18 @@ class Integrator {
       cells.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << q;
       cells.o |= static_cast<std::uint32_t>(cls == CellClass::kOccupied) << q;
     }
-    return updateCells(n, cells, s);
+    return updateCells(n, cells, s, ix0, iy0);
   }
 
   // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), cell q
   // E or O by bit q of `cells` (U when in neither), and to the Gaussians of those cells (the
   // slot's span); with kHits, lists its O cells (codes slot_code_ + q); returns the change of n's
-  // average.
-  double updateCells(Node& n, const CellMasks& cells, double s) {
+  // average. Its first cell (ix0, iy0) is not read: GCC 12 compiles the walk without hits as it
+  // did only with them there (80 m / 5 cm clamp, 300 scans: 19,394 M instructions, 19,474 M
+  // without); inlined, the walk with hits is 1.7 % shorter.
+  [[gnu::always_inline]] double updateCells(Node& n, const CellMasks& cells, double s,
+                                            [[maybe_unused]] std::int64_t ix0,
+                                            [[maybe_unused]] std::int64_t iy0) {
     visited_ += 4;
     if constexpr (kNdt) {
       const std::uint32_t observed = cells.e | cells.o;
@@ -261,7 +265,7 @@ class Integrator {
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
-        return updateCells(m, cc, c[qu]);
+        return updateCells(m, cc, c[qu], ix0 + (q & 1) * 2, iy0 + (q >> 1) * 2);
       });
     }
     return foldChanges(n, delta);
@@ -296,7 +300,8 @@ class Integrator {
   NdtBlockUpdate* const ndt_;
   HitBlockUpdate* const hits_;
   std::vector<HitObservation>* const observed_;
-  // kNdt: the Gaussians under the slot being updated; kNdt, kHits: a classification holding it. A visit reads them on entry (children set them again, one after the other).
+  // kNdt: the Gaussians under the slot being updated; kNdt, kHits: a classification holding it. A
+  // visit reads them on entry (children set them again, one after the other).
   NdtSpan slot_span_;
   const SquareInfo* slot_box_ = nullptr;
   // kHits: the codes of the slot being updated, [slot_code_, slot_code_ + 4^slot_level_).

@@ -137,14 +137,15 @@ class HitBlockUpdate {
     const HitObservation* first = obs_.data();
     const HitObservation* last = first + obs_.size();
     if (c_.ratios) {
-      upsert(&cells.ratios, &cells.bits, first, last,
-             [this](HitRatio& e, const HitObservation& o) { renew(&e, o); },
-             [this](const HitObservation& o) {
-               HitRatio e;
-               e.code = o.code;
-               renew(&e, o);
-               return e;
-             });
+      upsert(
+          &cells.ratios, &cells.bits, first, last,
+          [this](HitRatio& e, const HitObservation& o) { renew(&e, o); },
+          [this](const HitObservation& o) {
+            HitRatio e;
+            e.code = o.code;
+            renew(&e, o);
+            return e;
+          });
       // Sweep now and then, and soon when the block's hits stop (its cells then fade fast).
       if (sweepDue(&cells)) sweep(&cells.ratios, ix0, iy0);
     } else if (c_.pairs) {
@@ -161,16 +162,17 @@ class HitBlockUpdate {
       cells.pairs.mergeTail();         // one run for the next walk's cursor
       if (sweepDue(&cells)) sweepPairs(&cells.pairs, ix0, iy0);
     } else {
-      upsert(&cells.counts, &cells.bits, first, last,
-             [](HitCount& e, const HitObservation&) {
-               if (e.n != std::numeric_limits<std::uint32_t>::max()) ++e.n;
-             },
-             [](const HitObservation& o) {
-               HitCount e;
-               e.code = o.code;
-               e.n = 1;
-               return e;
-             });
+      upsert(
+          &cells.counts, &cells.bits, first, last,
+          [](HitCount& e, const HitObservation&) {
+            if (e.n != std::numeric_limits<std::uint32_t>::max()) ++e.n;
+          },
+          [](const HitObservation& o) {
+            HitCount e;
+            e.code = o.code;
+            e.n = 1;
+            return e;
+          });
     }
     obs_.clear();
   }
