@@ -141,8 +141,7 @@ struct CellRuns {
     const std::size_t k = std::max<std::size_t>(1, added_);
     added_ = 0;
     if (tail <= kTail || tail * tail <= 4 * sorted * k) return;
-    mergeBack(0, sorted);
-    sorted = entries.size();
+    mergeTail();
   }
   /// Merges the tail into the first run.
   void mergeTail() {

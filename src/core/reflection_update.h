@@ -57,7 +57,7 @@ class HitBlockUpdate {
     runs_ = b.hits ? &b.hits->pairs : nullptr;
     ahead_ = end_ = nullptr;
     if (runs_ != nullptr) {
-      if (runs_->sorted != runs_->entries.size()) runs_->mergeTail();  // one run (a loaded file)
+      runs_->mergeTail();  // one run for the cursor: the last scan's new cells merged in
       ahead_ = runs_->entries.data();
       end_ = ahead_ + runs_->entries.size();
     }
@@ -159,7 +159,6 @@ class HitBlockUpdate {
         return e;
       });
       cells.pairs.removeDeadIfMany();  // the walk's drops
-      cells.pairs.mergeTail();         // one run for the next walk's cursor
       if (sweepDue(&cells)) sweepPairs(&cells.pairs, ix0, iy0);
     } else {
       upsert(

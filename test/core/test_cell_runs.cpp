@@ -50,6 +50,32 @@ void expectSame(const CellRuns<HitCount>& runs,
   EXPECT_EQ(live, want);
 }
 
+// One scan's upsertSorted() of `items` as the reflection map makes it: the bits rebuilt when out
+// of step, set for each new entry (a count of 1), asked before each search; update(e) on the
+// entries found. Returns the cells searched.
+template <typename Update>
+std::size_t upsertWithBits(CellRuns<HitCount>* runs, CellBits* bits, const std::vector<Item>& items,
+                           Update update) {
+  if (!bits->inStep(*runs)) bits->rebuild(*runs, kLevels);
+  std::size_t searched = 0;
+  runs->upsertSorted(
+      items.data(), items.data() + items.size(), [&](HitCount& e, const Item&) { update(e); },
+      [bits](const Item& it) {
+        bits->set(it.code);
+        HitCount e;
+        e.code = it.code;
+        e.n = 1;
+        return e;
+      },
+      [&](std::uint32_t code) {
+        const bool may = bits->test(code);
+        searched += may ? 1 : 0;
+        return may;
+      });
+  bits->step(*runs);
+  return searched;
+}
+
 TEST(CellRuns, GallopsFindTheBounds) {
   std::mt19937 rng(7);
   for (int round = 0; round < 200; ++round) {
@@ -91,23 +117,10 @@ TEST(CellRuns, ScansOfUpdatesAndNewCellsDropsAndMerges) {
     std::vector<Item> items;
     for (std::uint32_t c : codes) items.push_back({c});
 
-    if (!bits.inStep(runs)) bits.rebuild(runs, kLevels);
-    runs.upsertSorted(
-        items.data(), items.data() + items.size(),
-        [](HitCount& e, const Item&) { e.n = e.live() ? e.n + 1 : 1; },
-        [&bits](const Item& it) {
-          bits.set(it.code);
-          HitCount e;
-          e.code = it.code;
-          e.n = 1;
-          return e;
-        },
-        [&](std::uint32_t code) {
-          const bool may = bits.test(code);
-          (may ? searched : skipped) += 1;
-          return may;
-        });
-    bits.step(runs);
+    const std::size_t found =
+        upsertWithBits(&runs, &bits, items, [](HitCount& e) { e.n = e.live() ? e.n + 1 : 1; });
+    searched += found;
+    skipped += items.size() - found;
     for (std::uint32_t c : codes) ++want[c];
     if (scan % 3 == 0) {
       runs.mergeTailIfLong();
@@ -144,18 +157,7 @@ TEST(CellBits, SetExactlyWhereAnEntryIsAfterEveryChange) {
   for (int round = 0; round < 60; ++round) {
     std::vector<Item> items;
     for (std::uint32_t c = rng() % 64; c < kCells; c += 1 + rng() % 97) items.push_back({c});
-    if (!bits.inStep(runs)) bits.rebuild(runs, kLevels);
-    runs.upsertSorted(
-        items.data(), items.data() + items.size(), [](HitCount& e, const Item&) { e.n = 1; },
-        [&bits](const Item& it) {
-          bits.set(it.code);
-          HitCount e;
-          e.code = it.code;
-          e.n = 1;
-          return e;
-        },
-        [&bits](std::uint32_t code) { return bits.test(code); });
-    bits.step(runs);
+    upsertWithBits(&runs, &bits, items, [](HitCount& e) { e.n = 1; });
     runs.mergeTailIfLong();
     if (round % 4 == 3) runs.removeIf([&rng](const HitCount&) { return rng() % 3 == 0; });
     // Out of step after entries were removed; rebuilt, exact.
