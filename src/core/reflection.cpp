@@ -14,6 +14,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "cell_reader.h"
 #include "map_impl.h"
 #include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -137,15 +138,15 @@ float probability(double h, double m) {
   return static_cast<float>(std::fmin(1.0, std::fmax(0.0, h / total)));
 }
 
-// The hits of the cell (ix, iy) of an entry (under "forget", read with its occupancy).
-double hitsOf(const WaveletMap::Impl&, const detail::HitCount& e, std::int64_t, std::int64_t) {
+// The hits of the cell of an entry (under "forget", read with its occupancy).
+double hitsOf(const WaveletMap::Impl&, const detail::HitCount& e, detail::BlockCellReader*) {
   return static_cast<double>(e.n);
 }
-double hitsOf(const WaveletMap::Impl& impl, const detail::HitRatio& e, std::int64_t ix,
-              std::int64_t iy) {
-  return impl.reflection_basis.hitsFromRatio(impl.read(0, ix, iy).average, e.q);
+double hitsOf(const WaveletMap::Impl& impl, const detail::HitRatio& e,
+              detail::BlockCellReader* occupancy) {
+  return impl.reflection_basis.hitsFromRatio(occupancy->average(e.code), e.q);
 }
-double hitsOf(const WaveletMap::Impl&, const detail::HitPair& e, std::int64_t, std::int64_t) {
+double hitsOf(const WaveletMap::Impl&, const detail::HitPair& e, detail::BlockCellReader*) {
   return static_cast<double>(e.h);
 }
 
@@ -155,10 +156,12 @@ struct HitSums {
   std::vector<double> h, dm;
 };
 
-// Adds the hits of every hit cell in `window` (scale-s cells) to `sums`.
+// Adds the hits of every hit cell of block `b` (origin cell x0, y0) in `window` (scale-s cells)
+// to `sums`.
 template <typename Entry>
-void addHits(const WaveletMap::Impl& impl, const detail::CellRuns<Entry>& runs, std::int64_t x0,
-             std::int64_t y0, int s, const CellBox& window, HitSums* sums) {
+void addHits(const WaveletMap::Impl& impl, const Block& b, const detail::CellRuns<Entry>& runs,
+             std::int64_t x0, std::int64_t y0, int s, const CellBox& window, HitSums* sums) {
+  detail::BlockCellReader occupancy(impl, b);
   for (const Entry& e : runs.entries) {
     if (!e.live()) continue;
     std::uint32_t lx, ly;
@@ -169,10 +172,12 @@ void addHits(const WaveletMap::Impl& impl, const detail::CellRuns<Entry>& runs, 
       continue;
     const auto k =
         static_cast<std::size_t>((ry - window.min_y) * window.width() + (rx - window.min_x));
-    sums->h[k] += hitsOf(impl, e, ix, iy);
+    sums->h[k] += hitsOf(impl, e, &occupancy);
     if constexpr (std::is_same_v<Entry, detail::HitPair>) {
-      sums->dm[k] +=
-          static_cast<double>(e.m) - impl.unhitMisses(ix, iy, impl.read(0, ix, iy).average);
+      // (After a restart the misses of a cell never hit are a layer's, not its occupancy's.)
+      const double l =
+          impl.reflection_mode == ReflectionMode::kCounts ? 0.0 : occupancy.average(e.code);
+      sums->dm[k] += static_cast<double>(e.m) - impl.unhitMisses(ix, iy, l);
     }
   }
 }
@@ -192,9 +197,9 @@ HitSums meanHits(const WaveletMap::Impl& impl, int s, const CellBox& window) {
       continue;
     }
     const std::int64_t x0 = detail::scaleUp(bx, L), y0 = detail::scaleUp(by, L);
-    addHits(impl, b.hits->counts, x0, y0, s, window, &sums);
-    addHits(impl, b.hits->ratios, x0, y0, s, window, &sums);
-    addHits(impl, b.hits->pairs, x0, y0, s, window, &sums);
+    addHits(impl, b, b.hits->counts, x0, y0, s, window, &sums);
+    addHits(impl, b, b.hits->ratios, x0, y0, s, window, &sums);
+    addHits(impl, b, b.hits->pairs, x0, y0, s, window, &sums);
   }
   const double cells = std::ldexp(1.0, 2 * s);
   for (double& v : sums.h) v /= cells;

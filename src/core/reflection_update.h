@@ -16,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+#include "cell_reader.h"
 #include "map_impl.h"
 #include "reflection_store.h"
 #include "scan_classifier.h"
@@ -147,7 +148,7 @@ class HitBlockUpdate {
             return e;
           });
       // Sweep now and then, and soon when the block's hits stop (its cells then fade fast).
-      if (sweepDue(&cells)) sweep(&cells.ratios, ix0, iy0);
+      if (sweepDue(&cells)) sweep(b, &cells.ratios);
     } else if (c_.pairs) {
       // The walk counted the cells with an entry (visitCells): these are new.
       cells.pairs.insertNewSorted(first, last, [this, ix0, iy0](const HitObservation& o) {
@@ -159,7 +160,7 @@ class HitBlockUpdate {
         return e;
       });
       cells.pairs.removeDeadIfMany();  // the walk's drops
-      if (sweepDue(&cells)) sweepPairs(&cells.pairs, ix0, iy0);
+      if (sweepDue(&cells)) sweepPairs(b, &cells.pairs, ix0, iy0);
     } else {
       upsert(
           &cells.counts, &cells.bits, first, last,
@@ -256,7 +257,8 @@ class HitBlockUpdate {
   // Pairs: drops the entries whose hits have faded to a kFadedHits share of their count and whose
   // misses are those the cell reads without an entry (to kFadedHits of the bound), so that the
   // cell's counts change by less than that.
-  void sweepPairs(CellRuns<HitPair>* runs, std::int64_t ix0, std::int64_t iy0) {
+  void sweepPairs(const Block& b, CellRuns<HitPair>* runs, std::int64_t ix0, std::int64_t iy0) {
+    BlockCellReader reader(impl_, b);
     for (HitPair& e : runs->entries) {
       if (!e.live()) continue;
       const double h = e.h, m = e.m;
@@ -265,20 +267,18 @@ class HitBlockUpdate {
       mortonCell(e.code, &lx, &ly);
       const std::int64_t ix = ix0 + lx, iy = iy0 + ly;
       const double unhit =
-          impl_.unhitMisses(ix, iy, counted_misses_ ? 0.0 : impl_.read(0, ix, iy).average);
+          impl_.unhitMisses(ix, iy, counted_misses_ ? 0.0 : reader.average(e.code));
       if (std::fabs(unhit - m) <= kFadedHits * std::max(1.0, m)) runs->drop(&e);
     }
     runs->removeDeadIfMany();
   }
 
   // Drops the ratios of cells whose hits have faded below kFadedHits.
-  void sweep(CellRuns<HitRatio>* runs, std::int64_t ix0, std::int64_t iy0) {
+  void sweep(const Block& b, CellRuns<HitRatio>* runs) {
+    BlockCellReader reader(impl_, b);
     for (HitRatio& e : runs->entries) {
       if (!e.live()) continue;
-      std::uint32_t lx, ly;
-      mortonCell(e.code, &lx, &ly);
-      const double before = impl_.read(0, ix0 + lx, iy0 + ly).average;
-      if (c_.basis.hitsFromRatio(before, e.q) < kFadedHits) runs->drop(&e);
+      if (c_.basis.hitsFromRatio(reader.average(e.code), e.q) < kFadedHits) runs->drop(&e);
     }
     runs->removeDeadIfMany();
   }

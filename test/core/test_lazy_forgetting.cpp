@@ -2,10 +2,13 @@
 // equality with eager forgetting and with the reference, pruning of long-empty regions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <random>
 #include <tuple>
 
+#include "../../src/core/cell_reader.h"
 #include "dense_reference.h"
 #include "map_access.h"
 #include "test_support.h"
@@ -65,7 +68,8 @@ struct NodeKey {
 
 TEST(LazyForgetting, EmptyScansTagNodesAndLeaveStoredDetailsUntouched) {
   WaveletMap map(forgetParams(true));
-  for (int i = 0; i < 5; ++i) map.integrate({0.1 * i, 0.05 * i, 0.1 * i}, roomScan({0.1 * i, 0.05 * i, 0.1 * i}, 2.0).view());
+  for (int i = 0; i < 5; ++i)
+    map.integrate({0.1 * i, 0.05 * i, 0.1 * i}, roomScan({0.1 * i, 0.05 * i, 0.1 * i}, 2.0).view());
   std::map<const void*, std::tuple<float, float, float, int>> before;
   wavog::MapAccess::forEachNode(map, [&](const wavog::detail::Node& n, int, int pending) {
     before[&n] = {n.d[0], n.d[1], n.d[2], pending};
@@ -113,6 +117,48 @@ TEST(LazyForgetting, ClosedFormEqualsEagerSteps) {
     EXPECT_NEAR(lazy.value(c), closed, 1e-4) << c.x << "," << c.y;
     EXPECT_NEAR(eager.value(c), lazy.value(c), 1e-4) << c.x << "," << c.y;
   }
+}
+
+// The reflection map's sweeps read many cells of a block at once (BlockCellReader): each read
+// must give what WaveletMap::Impl::read gives, through pending tags (the far empty scans) and
+// pruned subtrees (tau > 0), whatever the order of the cells.
+TEST(LazyForgetting, BlockCellReaderReadsWhatReadReads) {
+  WaveletMap map(forgetParams(true, 0.01));
+  for (int i = 0; i < 4; ++i) {
+    const wavog::Pose2 pose{0.1 * i, 0.05 * i, 0.1 * i};
+    map.integrate(pose, roomScan(pose, 2.0).view());
+  }
+  const OwnedScan e = farEmptyScan();
+  for (int i = 0; i < 3; ++i) map.integrate(e.pose, e.view());
+  const wavog::WaveletMap::Impl& impl = wavog::MapAccess::impl(map);
+  std::size_t pending = 0;
+  wavog::MapAccess::forEachNode(
+      map, [&](const wavog::detail::Node& n, int, int) { pending += n.k != 0 ? 1 : 0; });
+  ASSERT_GT(pending, 10u);  // tags to read through
+  const std::uint32_t cells = 1u << (2 * impl.levels);
+  std::mt19937 rng(7);
+  std::size_t compared = 0, detailed = 0;
+  for (const auto& kv : impl.blocks) {
+    const std::int64_t x0 = wavog::detail::scaleUp(wavog::detail::blockKeyX(kv.first), impl.levels);
+    const std::int64_t y0 = wavog::detail::scaleUp(wavog::detail::blockKeyY(kv.first), impl.levels);
+    std::vector<std::uint32_t> codes(cells);
+    for (std::uint32_t c = 0; c < cells; ++c) codes[c] = c;
+    for (int order = 0; order < 2; ++order) {
+      if (order == 1) std::shuffle(codes.begin(), codes.end(), rng);
+      wavog::detail::BlockCellReader reader(impl, kv.second);
+      for (std::uint32_t c : codes) {
+        std::uint32_t lx, ly;
+        wavog::detail::mortonCell(c, &lx, &ly);
+        const double want = impl.read(0, x0 + lx, y0 + ly).average;
+        const double got = reader.average(c);
+        ASSERT_EQ(got, want) << "block " << x0 << "," << y0 << " cell " << lx << "," << ly;
+        ++compared;
+        detailed += want != kv.second.s ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(compared, 10000u);
+  EXPECT_GT(detailed, 1000u);  // cells that differ from their block's mean
 }
 
 TEST(LazyForgetting, RepeatedEmptyScansCostDoesNotGrowWithDetail) {
