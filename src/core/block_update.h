@@ -38,7 +38,7 @@ template <PolicyType P, bool kNdt, bool kHits = false>
                                              const std::vector<BlockJob>& jobs,
                                              std::atomic<std::size_t>* next) {
   NdtBlockUpdate ndt_update(cls, ndt != nullptr ? *ndt : NdtConsts{});
-  HitBlockUpdate hit_update(impl, cls, hits != nullptr ? *hits : HitConsts{});
+  HitBlockUpdate hit_update(impl, hits != nullptr ? *hits : HitConsts{});
   Integrator<P, kNdt, kHits> integrator(impl, store, cls, pc, &ndt_update, &hit_update);
   for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < jobs.size();
        i = next->fetch_add(1, std::memory_order_relaxed)) {
@@ -50,10 +50,6 @@ template <PolicyType P, bool kNdt, bool kHits = false>
                  : NdtSpan{};
     if constexpr (kNdt) {
       integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box, ndt_span);
-    } else if constexpr (kHits && boundsCounts(P)) {
-      // The clamps: the walk counts the misses of the block's hit cells.
-      hit_update.begin(*j.block, j.ix0, j.iy0);
-      integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
     } else {
       integrator.integrateBlock(*j.block, j.ix0, j.iy0, j.box);
     }

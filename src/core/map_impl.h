@@ -142,6 +142,9 @@ struct WaveletMap::Impl {
   /// Starts the reflection map afresh from no hits and no misses: in the mode of params' policy
   /// when the occupancy is empty too (`fresh`), else in one that does not read the occupancy.
   void restartReflection(bool fresh);
+  /// Before a policy change to `next`: the clamps' pairs brought up to date under params (their
+  /// misses so far read from the occupancy, which the change may re-clamp at its next update).
+  void settlePairs(const MapParams& next);
   /// After a policy change: restarts the reflection map if its basis changed (the counts of one
   /// policy mean something else under another), else re-parameterises its layers.
   void configureReflection();

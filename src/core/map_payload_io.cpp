@@ -10,6 +10,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "cell_reader.h"
 #include "map_codec.h"
 
 namespace wavog {
@@ -34,6 +35,22 @@ std::vector<Entry> liveInCodeOrder(const CellRuns<Entry>& runs) {
   std::sort(cells.begin(), cells.end(),
             [](const Entry& a, const Entry& b) { return a.code < b.code; });
   return cells;
+}
+
+// The clamps' pairs of block `b` with their counts as of now (the misses since each one's last
+// hit read from the occupancy), as a file holds them.
+CellRuns<HitPair> pairsNow(const WaveletMap::Impl& impl, const Block& b) {
+  CellRuns<HitPair> now = b.hits->pairs;
+  BlockCellReader occupancy(impl, b);
+  for (HitPair& e : now.entries) {
+    if (!e.live()) continue;
+    const double l = occupancy.average(e.code);
+    const PairCounts c = pairNow(e, l, impl.params);
+    e.h = static_cast<float>(c.h);
+    e.m = static_cast<float>(c.m);
+    e.l = static_cast<float>(l);
+  }
+  return now;
 }
 
 // The block (bx, by) of `fresh` that a section says holds n cells of `cell_bytes` each; `what`
@@ -200,7 +217,7 @@ void writeReflection(const WaveletMap::Impl& impl, Writer* w) {
     const std::int64_t bx = blockKeyX(kv.first), by = blockKeyY(kv.first);
     writeHitRuns(kv.second.hits->counts, bx, by, 0, w);
     writeHitRuns(kv.second.hits->ratios, bx, by, 1, w);
-    writeHitRuns(kv.second.hits->pairs, bx, by, 2, w);
+    if (!kv.second.hits->pairs.empty()) writeHitRuns(pairsNow(impl, kv.second), bx, by, 2, w);
   }
 }
 
@@ -240,6 +257,9 @@ FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::uint32_t 
       readHitRuns(n, fresh.levels, &b.hits->ratios, r);
     } else {
       readHitRuns(n, fresh.levels, &b.hits->pairs, r);
+      // The counts are as of the file's occupancy (read before the hits).
+      BlockCellReader occupancy(fresh, b);
+      for (HitPair& e : b.hits->pairs.entries) e.l = static_cast<float>(occupancy.average(e.code));
     }
   }
   // Before version 5 the clamps counted without bound: such a reflection map restarts.

@@ -4,8 +4,8 @@
 // into the parent's details with one forward Haar step. With kNdt (MapParams::ndt and "forget")
 // the walk also carries the span of the block's Gaussians under each square and forgets those the
 // scan observes (ndt_update.h); with kHits (MapParams::reflection) it lists the occupied cells
-// and, under the clamps, counts the misses and hits of the block's hit cells as it passes them
-// (reflection_update.h). Not installed; included only by src/core/integrate*.cpp.
+// for the reflection map (reflection_update.h). Not installed; included only by
+// src/core/integrate*.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_QUADTREE_UPDATE_H_
 
@@ -38,14 +38,10 @@ struct NoSpans {
 template <PolicyType P, bool kNdt = false, bool kHits = false>
 class Integrator {
   using Spans = std::conditional_t<kNdt, std::array<NdtSpan, 4>, NoSpans>;
-  // Under the clamps (kHits), the walk meets the block's hit cells in code order, as it visits
-  // the squares, with HitBlockUpdate's cursor.
-  static constexpr bool kMissCursor = kHits && boundsCounts(P);
 
  public:
   /// Node groups come from and go to `store` (one Integrator per thread); with kNdt, the
-  /// Gaussians' forgetting goes to `ndt`; with kHits, the occupied cells go to `hits` (and the
-  /// misses of hit cells under the clamps).
+  /// Gaussians' forgetting goes to `ndt`; with kHits, the occupied cells go to `hits`.
   Integrator(WaveletMap::Impl& impl, NodeStore& store, const ScanClassifier& classifier,
              const PolicyConsts& pc, NdtBlockUpdate* ndt = nullptr, HitBlockUpdate* hits = nullptr)
       : impl_(impl),
@@ -54,7 +50,6 @@ class Integrator {
         pc_(pc),
         lazy_(impl.params.lazy_forgetting),
         ndt_(ndt),
-        hits_(hits),
         observed_(hits != nullptr ? hits->observations() : nullptr) {}
 
   /// Tree nodes and finest cells visited so far.
@@ -67,7 +62,7 @@ class Integrator {
     RootSlot slot(impl_, store_, b);
     const double s = b.s;
     if constexpr (kNdt) enterSlot(sp, box);
-    if constexpr (kHits) enterCells(0, impl_.levels, box);
+    if constexpr (kHits) enterCells(0);
     b.s += updateSlot(slot, box.cls, s,
                       [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
   }
@@ -88,17 +83,11 @@ class Integrator {
       case CellClass::kEmpty:
         if (node == nullptr) {  // uniform block: exact for every policy
           if constexpr (kNdt) forgetSlot();
-          if constexpr (kMissCursor) {
-            hits_->missRange(slot_code_, slot_level_, applyPolicy<P>(pc_, CellClass::kEmpty, s));
-          }
           slot.setKnown(true, true);
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
         }
         if (kAffineEmpty<P> && node->known_all == 0xF) {
           if constexpr (kNdt) forgetSlot();
-          if constexpr (kMissCursor) {  // clamp_upper, which has no empty bound
-            hits_->missRange(slot_code_, slot_level_, std::numeric_limits<double>::quiet_NaN());
-          }
           if constexpr (P == PolicyType::kForget) forgetSubtree(slot, node);
           slot.setKnown(true, true);
           return applyPolicy<P>(pc_, CellClass::kEmpty, s) - s;
@@ -110,8 +99,6 @@ class Integrator {
             std::fabs(applyPolicy<P>(pc_, CellClass::kEmpty, s) - s) <= pc_.unchanged_tol) {
           if constexpr (kNdt) {
             if (!slot_span_.empty()) ndt_->forgetObserved(slot_span_, *slot_box_);
-          } else if constexpr (kMissCursor) {
-            hits_->missObservedRange(slot_code_, slot_level_, *slot_box_, s);
           }
           return 0.0;
         }
@@ -127,13 +114,8 @@ class Integrator {
     slot_span_ = sp;
     slot_box_ = &box;
   }
-  // kHits: the next slot to update holds the cells of codes [code, code + 4^level), inside the
-  // square classified as `box`.
-  void enterCells(std::uint32_t code, int level, const SquareInfo& box) {
-    slot_code_ = code;
-    slot_level_ = level;
-    slot_box_ = &box;
-  }
+  // kHits: the first cell of the next slot to update has code `code`.
+  void enterCells(std::uint32_t code) { slot_code_ = code; }
   // kNdt: the scan observes every cell of the slot.
   void forgetSlot() {
     slot_span_.forEach([this](NdtEntry* x) { ndt_->forget(x); });
@@ -176,7 +158,7 @@ class Integrator {
       ChildSlot slot(impl_, store_, n, q);
       if constexpr (kNdt) enterSlot(parts[qu], child_box);
       if constexpr (kHits) {
-        enterCells(code + (static_cast<std::uint32_t>(q) << (2 * (l - 1))), l - 1, child_box);
+        enterCells(code + (static_cast<std::uint32_t>(q) << (2 * (l - 1))));
       }
       delta[qu] = updateSlot(slot, child_box.cls, c[qu], [&](Node& m) {
         return visitNode(m, child_box, l - 1, cx, cy, c[qu]);
@@ -224,12 +206,8 @@ class Integrator {
       }
     }
     if constexpr (kHits) {
-      // slot_code_: this level-1 node's first cell, entered by its parent. Under the clamps the
-      // cells with an entry are counted on the way; the other O cells are listed.
-      std::uint32_t listed = cells.o;
-      if constexpr (kMissCursor)
-        listed &= ~hits_->visitCells(slot_code_, cells.e, cells.o, c, delta);
-      for (std::uint32_t o = listed; o != 0; o &= o - 1) {
+      // slot_code_: this level-1 node's first cell, entered by its parent.
+      for (std::uint32_t o = cells.o; o != 0; o &= o - 1) {
         const auto q = static_cast<unsigned>(__builtin_ctz(o));
         observed_->push_back({slot_code_ + q, c[q]});
       }
@@ -261,7 +239,7 @@ class Integrator {
       if (cls == CellClass::kUnknown) continue;
       ChildSlot slot(impl_, store_, n, q);
       if constexpr (kNdt) enterSlot(parts[qu], box);
-      if constexpr (kHits) enterCells(code + (static_cast<std::uint32_t>(q) << 2), 1, box);
+      if constexpr (kHits) enterCells(code + (static_cast<std::uint32_t>(q) << 2));
       delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
         ++visited_;
         impl_.flush(m);
@@ -298,15 +276,13 @@ class Integrator {
   const PolicyConsts pc_;
   const bool lazy_;
   NdtBlockUpdate* const ndt_;
-  HitBlockUpdate* const hits_;
   std::vector<HitObservation>* const observed_;
-  // kNdt: the Gaussians under the slot being updated; kNdt, kHits: a classification holding it. A
+  // kNdt: the Gaussians under the slot being updated and a classification holding them. A
   // visit reads them on entry (children set them again, one after the other).
   NdtSpan slot_span_;
   const SquareInfo* slot_box_ = nullptr;
-  // kHits: the codes of the slot being updated, [slot_code_, slot_code_ + 4^slot_level_).
+  // kHits: the first cell of the slot being updated.
   std::uint32_t slot_code_ = 0;
-  int slot_level_ = 0;
   std::uint64_t visited_ = 0;
 };
 

@@ -84,6 +84,33 @@ void WaveletMap::Impl::restartReflection(bool fresh) {
   if (layer_misses) make(&misses_layer, false);
 }
 
+void WaveletMap::Impl::settlePairs(const MapParams& next) {
+  if (!params.reflection || !detail::boundsCounts(params.policy.type)) return;
+  // A cell above a lowered clamp_max falls to it at its next miss: its reference is put where one
+  // miss takes it there, so that the miss counts one.
+  const double top = next.policy.type == PolicyType::kClampLower
+                         ? std::numeric_limits<double>::infinity()
+                         : next.policy.clamp_max - next.sensor.odd_emp;
+  const bool drop = reflection_mode != ReflectionMode::kCounts;
+  for (auto& kv : blocks) {
+    Block& b = kv.second;
+    if (!b.hits || b.hits->pairs.empty()) continue;
+    detail::BlockCellReader occupancy(*this, b);
+    for (detail::HitPair& e : b.hits->pairs.entries) {
+      if (!e.live()) continue;
+      const double l = occupancy.average(e.code);
+      const detail::PairCounts now = detail::pairNow(e, l, params);
+      if (now.at_bound && drop) {  // as the walk would have dropped it
+        b.hits->pairs.drop(&e);
+        continue;
+      }
+      e.h = static_cast<float>(now.h);
+      e.m = static_cast<float>(now.m);
+      e.l = static_cast<float>(std::min(l, top));
+    }
+  }
+}
+
 void WaveletMap::Impl::configureReflection() {
   if (!params.reflection) return;
   if (currentBasis() != reflection_basis) {
@@ -146,9 +173,6 @@ double hitsOf(const WaveletMap::Impl& impl, const detail::HitRatio& e,
               detail::BlockCellReader* occupancy) {
   return impl.reflection_basis.hitsFromRatio(occupancy->average(e.code), e.q);
 }
-double hitsOf(const WaveletMap::Impl&, const detail::HitPair& e, detail::BlockCellReader*) {
-  return static_cast<double>(e.h);
-}
 
 // Per scale-s cell of a window, row-major: the mean hits of its cells, and under the clamps the
 // mean of what the entries' misses add to those the cells read as never hit.
@@ -172,12 +196,13 @@ void addHits(const WaveletMap::Impl& impl, const Block& b, const detail::CellRun
       continue;
     const auto k =
         static_cast<std::size_t>((ry - window.min_y) * window.width() + (rx - window.min_x));
-    sums->h[k] += hitsOf(impl, e, &occupancy);
     if constexpr (std::is_same_v<Entry, detail::HitPair>) {
-      // (After a restart the misses of a cell never hit are a layer's, not its occupancy's.)
-      const double l =
-          impl.reflection_mode == ReflectionMode::kCounts ? 0.0 : occupancy.average(e.code);
-      sums->dm[k] += static_cast<double>(e.m) - impl.unhitMisses(ix, iy, l);
+      const double l = occupancy.average(e.code);
+      const detail::PairCounts now = detail::pairNow(e, l, impl.params);
+      sums->h[k] += now.h;
+      sums->dm[k] += now.m - impl.unhitMisses(ix, iy, l);
+    } else {
+      sums->h[k] += hitsOf(impl, e, &occupancy);
     }
   }
 }
@@ -291,8 +316,9 @@ float WaveletMap::reflection(const CellIndex& cell) const {
       h = impl.reflection_basis.hitsFromRatio(l, e->q);
     }
     if (const detail::HitPair* e = b->hits->pairs.find(code); e != nullptr && e->live()) {
-      h = e->h;
-      dm = static_cast<double>(e->m) - impl.unhitMisses(cell.x, cell.y, l);
+      const detail::PairCounts now = detail::pairNow(*e, l, impl.params);
+      h = now.h;
+      dm = now.m - impl.unhitMisses(cell.x, cell.y, l);
     }
   }
   return fromCounts(impl, l, h, m, dm);

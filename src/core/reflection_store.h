@@ -8,6 +8,7 @@
 #define WAVOG_MAPPING_SRC_CORE_REFLECTION_STORE_H_
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -37,11 +38,13 @@ struct HitRatio {
 };
 
 /// The hits h and misses m of one hit cell under the clamp policies, whose total is bounded
-/// (ReflectionBasis::bound); a negative h is no entry.
+/// (ReflectionBasis::bound), as they were when the cell's log-odds were `l` (after its last hit):
+/// the misses since then are read from the occupancy (pairNow); a negative h is no entry.
 struct HitPair {
   std::uint32_t code = 0;
   float h = -1.0f;
   float m = 0.0f;
+  float l = 0.0f;
 
   bool live() const { return h >= 0.0f; }
   void kill() { h = -1.0f; }
@@ -81,16 +84,17 @@ class CellBits {
   std::size_t size_ = 0;
 };
 
-/// A block's hits: `counts`, `ratios` or `pairs`, by the map's policy, with `bits` of the cells of
-/// counts or ratios. `scans`: integrations that met the block since its ratios were last swept of
-/// the cells whose hits have faded; `quiet`: the last of them in a row without a hit
-/// (reflection_update.h).
+/// A block's hits: `counts`, `ratios` or `pairs`, by the map's policy, with `bits` of the cells
+/// with an entry. `scans`: integrations that met the block since its entries were last swept of
+/// the cells whose hits have faded; `quiet`: the last of them in a row without a hit; `swept`: the
+/// entries that sweep left (reflection_update.h).
 struct HitCells {
   CellRuns<HitCount> counts;
   CellRuns<HitRatio> ratios;
   CellRuns<HitPair> pairs;
   CellBits bits;
   std::uint32_t scans = 0, quiet = 0;
+  std::size_t swept = 0;  // entries the last sweep left
 
   bool empty() const { return counts.empty() && ratios.empty() && pairs.empty(); }
 };
@@ -120,9 +124,51 @@ inline double emptyBound(const MapParams& p) {
   return p.policy.clamp_min;
 }
 
+/// The clamps: the log-odds of a cell of log-odds `l` after a hit (clamp_max bounds them under
+/// "clamp" and "clamp_upper").
+inline double afterHit(const MapParams& p, double l) {
+  const double up = l + p.sensor.odd_occ;
+  return p.policy.type == PolicyType::kClampLower ? up : std::min(up, p.policy.clamp_max);
+}
+
 /// Log-odds above clamp_min within which a cell's occupancy counts as at its empty bound (float
 /// round-off of the tree's coefficients; the clamps' reflection map resets the cell there).
 constexpr double kAtEmptyBound = 1e-5;
+
+/// The counts of a hit cell under the clamps.
+struct PairCounts {
+  double h = 0.0, m = 0.0;
+  bool at_bound = false;  ///< the occupancy is at its empty bound: the hits are forgotten
+};
+
+/// Log-odds within which a hit cell reads as not updated since its pair was brought up to date
+/// (the float round-off of reading it back through the tree's details is far below).
+constexpr double kUnmoved = 1e-4;
+
+/// The clamps: the counts of pair `e` once its cell reads log-odds `l`. Between two hits only
+/// misses change a cell, each by odd_emp, until its empty bound (where the walk would have reset
+/// it: h = 0, m = the bound), so that n = (l - e.l) / odd_emp misses came since e was brought up to
+/// date; each added 1 to m and scaled h and m to keep h + m <= bound: the first ones that fit add
+/// 1, the next one scales to the bound, each further one scales h by bound / (bound + 1). The
+/// counts come as floats, as an entry holds them (a file's are read back exactly).
+inline PairCounts pairNow(const HitPair& e, double l, double odd_emp, double bound,
+                          double empty_bound) {
+  const double h = e.h, m = e.m;
+  const double moved = l - static_cast<double>(e.l);
+  if (std::fabs(moved) <= kUnmoved) return {h, m, false};  // no miss since
+  if (l <= empty_bound + kAtEmptyBound) return {0.0, static_cast<float>(bound), true};
+  const double n = std::max(0.0, std::round(moved / odd_emp));
+  const double room = bound - (h + m);  // misses that fit under the bound (inf without one)
+  if (!(n > room)) return {h, static_cast<float>(m + n), false};
+  const double fit = std::max(0.0, std::floor(room));
+  const auto scaled = static_cast<float>(
+      h * (bound / (h + m + fit + 1.0)) * std::pow(bound / (bound + 1.0), n - fit - 1.0));
+  return {scaled, static_cast<float>(bound - scaled), false};
+}
+/// pairNow() with the bound of map parameters `p`.
+inline PairCounts pairNow(const HitPair& e, double l, const MapParams& p) {
+  return pairNow(e, l, p.sensor.odd_emp, countBound(p), emptyBound(p));
+}
 
 /// What the occupancy of a cell says about its hits h and misses m when the map has applied one
 /// policy with the same odd values and prior since it was empty (ALGORITHM.md; docs/algorithm.md):

@@ -87,6 +87,7 @@ void WaveletMap::setPolicy(const PolicyParams& policy, const SensorModelParams& 
   throwIfInvalid(p);
   impl_->flushAll();  // pending counts stand for a^k with the old a (ALGORITHM.md F5)
   const double old_init = impl_->init;
+  impl_->settlePairs(p);
   impl_->params = p;
   impl_->configure();
   impl_->configureReflection();
