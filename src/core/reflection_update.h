@@ -8,7 +8,6 @@
 #define WAVOG_MAPPING_SRC_CORE_REFLECTION_UPDATE_H_
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -69,7 +68,10 @@ class HitBlockUpdate {
             return e;
           });
       // Sweep now and then, and soon when the block's hits stop (its cells then fade fast).
-      if (sweepDue(&cells, cells.ratios)) sweep(b, &cells.ratios);
+      if (sweepDue(&cells, cells.ratios)) {
+        sweep(b, &cells.ratios);
+        cells.swept = cells.ratios.entries.size();
+      }
     } else if (c_.pairs) {
       upsert(
           &cells.pairs, &cells.bits, first, last,
@@ -80,7 +82,10 @@ class HitBlockUpdate {
             hitPair(&e, o, ix0, iy0);
             return e;
           });
-      if (sweepDue(&cells, cells.pairs)) sweepPairs(b, &cells.pairs, ix0, iy0);
+      if (sweepDue(&cells, cells.pairs)) {
+        sweepPairs(b, &cells.pairs, ix0, iy0);
+        cells.swept = cells.pairs.entries.size();
+      }
     } else {
       upsert(
           &cells.counts, &cells.bits, first, last,
@@ -187,7 +192,6 @@ class HitBlockUpdate {
       if (std::fabs(unhit - now.m) <= kFadedHits * std::max(1.0, now.m)) runs->drop(&e);
     }
     runs->removeDeadIfMany();
-    b.hits->swept = runs->entries.size();
   }
 
   // Drops the ratios of cells whose hits have faded below kFadedHits.
@@ -198,7 +202,6 @@ class HitBlockUpdate {
       if (c_.basis.hitsFromRatio(reader.average(e.code), e.q) < kFadedHits) runs->drop(&e);
     }
     runs->removeDeadIfMany();
-    b.hits->swept = runs->entries.size();
   }
 
   const WaveletMap::Impl& impl_;
