@@ -145,6 +145,19 @@ struct PairCounts {
 /// (the float round-off of reading it back through the tree's details is far below).
 constexpr double kUnmoved = 1e-4;
 
+/// r^k for a whole number k: by squaring where 0 <= k < 2^32, a few multiplications for the
+/// counts of misses a cell can take between its bounds (std::pow costs some hundred instructions).
+/// k is -1 where a cell's counts were above a bound that it has just lowered (n = 0).
+inline double powCount(double r, double k) {
+  if (!(k >= 0.0 && k < 4294967296.0)) return std::pow(r, k);
+  auto e = static_cast<std::uint32_t>(k);
+  double out = 1.0;
+  for (; e != 0; e >>= 1, r *= r) {
+    if ((e & 1u) != 0) out *= r;
+  }
+  return out;
+}
+
 /// The clamps: the counts of pair `e` once its cell reads log-odds `l`. Between two hits only
 /// misses change a cell, each by odd_emp, until its empty bound (where the walk would have reset
 /// it: h = 0, m = the bound), so that n = (l - e.l) / odd_emp misses came since e was brought up to
@@ -161,8 +174,8 @@ inline PairCounts pairNow(const HitPair& e, double l, double odd_emp, double bou
   const double room = bound - (h + m);  // misses that fit under the bound (inf without one)
   if (!(n > room)) return {h, static_cast<float>(m + n), false};
   const double fit = std::max(0.0, std::floor(room));
-  const auto scaled = static_cast<float>(
-      h * (bound / (h + m + fit + 1.0)) * std::pow(bound / (bound + 1.0), n - fit - 1.0));
+  const auto scaled = static_cast<float>(h * (bound / (h + m + fit + 1.0)) *
+                                         powCount(bound / (bound + 1.0), n - fit - 1.0));
   return {scaled, static_cast<float>(bound - scaled), false};
 }
 /// pairNow() with the bound of map parameters `p`.
