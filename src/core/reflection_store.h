@@ -147,7 +147,6 @@ constexpr double kUnmoved = 1e-4;
 
 /// r^k for a whole number k: by squaring where 0 <= k < 2^32, a few multiplications for the
 /// counts of misses a cell can take between its bounds (std::pow costs some hundred instructions).
-/// k is -1 where a cell's counts were above a bound that it has just lowered (n = 0).
 inline double powCount(double r, double k) {
   if (!(k >= 0.0 && k < 4294967296.0)) return std::pow(r, k);
   auto e = static_cast<std::uint32_t>(k);
@@ -171,6 +170,9 @@ inline PairCounts pairNow(const HitPair& e, double l, double odd_emp, double bou
   if (std::fabs(moved) <= kUnmoved) return {h, m, false};  // no miss since
   if (l <= empty_bound + kAtEmptyBound) return {0.0, static_cast<float>(bound), true};
   const double n = std::max(0.0, std::round(moved / odd_emp));
+  // No whole miss (float round-off of a huge e.l in a file): the counts stand, above the bound
+  // too, which only the next miss scales down.
+  if (n == 0.0) return {h, m, false};
   const double room = bound - (h + m);  // misses that fit under the bound (inf without one)
   if (!(n > room)) return {h, static_cast<float>(m + n), false};
   const double fit = std::max(0.0, std::floor(room));

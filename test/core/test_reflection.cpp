@@ -9,13 +9,16 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "../../src/core/reflection_store.h"
 #include "dense_reference.h"
 #include "test_support.h"
 
@@ -541,6 +544,39 @@ TEST(Reflection, LongEmptyRunsShrinkItWithForgetting) {
       << "layers " << layers_before << " -> " << map.stats().reflection_bytes << " bytes, map "
       << main_before << " -> " << occupancyBytes();
   EXPECT_NEAR(map.reflection(map.cellAt(1.05, 2.05)), 0.0, 1e-6);
+}
+
+// The closed form of the clamps' pairs against the misses applied one by one (m + 1, then h and m
+// scaled to keep h + m <= bound), from counts under the bound and from counts above it (a file's,
+// or a bound just lowered); less than half a miss of log-odds (a huge e.l's float round-off) is
+// no miss. A fuzzed file once saved such a pair as m < 0, a file the loader refuses.
+TEST(Reflection, PairClosedFormEqualsMissesOneByOne) {
+  const double odd_emp = -0.4, bound = 5.0, no_bound = -std::numeric_limits<double>::infinity();
+  for (const auto& start : std::vector<std::pair<float, float>>{{1.0f, 0.0f}, {2.5f, 1.5f},
+                                                               {6.5f, 0.0f}, {4.0f, 3.0f}}) {
+    wavog::detail::HitPair e;
+    e.h = start.first;
+    e.m = start.second;
+    e.l = 2.0f;
+    double h = e.h, m = e.m;
+    for (int n = 0; n <= 40; ++n) {
+      SCOPED_TRACE("h " + std::to_string(e.h) + " m " + std::to_string(e.m) + " n " +
+                   std::to_string(n));
+      const wavog::detail::PairCounts c =
+          wavog::detail::pairNow(e, e.l + n * odd_emp, odd_emp, bound, no_bound);
+      EXPECT_NEAR(c.h, h, 1e-5 * bound);
+      EXPECT_NEAR(c.m, m, 1e-5 * bound);
+      EXPECT_GE(c.m, 0.0);
+      m += 1.0;
+      const double f = std::min(1.0, bound / (h + m));
+      h *= f;
+      m *= f;
+    }
+    const wavog::detail::PairCounts off = wavog::detail::pairNow(e, e.l + 0.45 * odd_emp, odd_emp,
+                                                                 bound, no_bound);
+    EXPECT_EQ(off.h, e.h);
+    EXPECT_EQ(off.m, e.m);
+  }
 }
 
 }  // namespace
