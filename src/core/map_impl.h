@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "block_hash.h"
+#include "cell_runs.h"
 #include "node_pool.h"
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -81,6 +82,14 @@ struct WaveletMap::Impl {
       return static_cast<double>(misses_layer->value({ix, iy}));
     }
     return reflection_basis.missesOfUnhit(l);
+  }
+  /// unhitMisses() of the cell `code` (Morton, cell_runs.h) of the block whose first cell is
+  /// (ix0, iy0): its position is decoded only where misses_layer holds the misses.
+  double unhitMisses(std::int64_t ix0, std::int64_t iy0, std::uint32_t code, double l) const {
+    if (reflection_mode != ReflectionMode::kCounts) return reflection_basis.missesOfUnhit(l);
+    std::uint32_t lx, ly;
+    detail::mortonCell(code, &lx, &ly);
+    return unhitMisses(ix0 + lx, iy0 + ly, l);
   }
   std::size_t nodes = 0;  ///< live nodes (roots included)
   std::uint64_t nodes_visited_last = 0;

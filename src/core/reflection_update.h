@@ -123,21 +123,14 @@ class HitBlockUpdate {
     e->q = static_cast<float>(std::min(1.0, c_.a * never) / h);
   }
 
-  // The misses of the never-hit cell `code` of the block at (ix0, iy0), of log-odds `l`; its
-  // position is decoded only where they are a restart's layer.
-  double unhitMisses(std::uint32_t code, double l, std::int64_t ix0, std::int64_t iy0) const {
-    if (!counted_misses_) return c_.basis.missesOfUnhit(l);
-    std::uint32_t lx, ly;
-    mortonCell(code, &lx, &ly);
-    return impl_.unhitMisses(ix0 + lx, iy0 + ly, l);
-  }
   // Pairs: a hit on the cell of `o` (entry e, live or not): its counts brought up to date, h + 1,
   // the total bounded, as of its log-odds after the hit.
   void hitPair(HitPair* e, const HitObservation& o, std::int64_t ix0, std::int64_t iy0) const {
     // Without an entry, or at the empty bound, the cell reads as never hit.
     const PairCounts now =
         e->live() ? pairNow(*e, o.before, c_.basis.odd_emp, c_.bound, c_.empty_bound)
-                  : PairCounts{0.0, std::max(0.0, unhitMisses(o.code, o.before, ix0, iy0)), false};
+                  : PairCounts{0.0, std::max(0.0, impl_.unhitMisses(ix0, iy0, o.code, o.before)),
+                               false};
     const double h = now.h + 1.0, m = now.m;
     const double f = std::min(1.0, c_.bound / (h + m));
     e->h = static_cast<float>(h * f);
@@ -189,7 +182,7 @@ class HitBlockUpdate {
         continue;
       }
       if (!(now.h <= kFadedHits * (now.h + now.m))) continue;
-      const double unhit = unhitMisses(e.code, l, ix0, iy0);
+      const double unhit = impl_.unhitMisses(ix0, iy0, e.code, l);
       if (std::fabs(unhit - now.m) <= kFadedHits * std::max(1.0, now.m)) runs->drop(&e);
     }
     runs->removeDeadIfMany();
