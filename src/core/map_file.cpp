@@ -10,6 +10,7 @@
 #include <cstring>
 #include <random>
 
+#include "wavog_mapping/core/atomic_file.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
@@ -53,20 +54,20 @@ int createTemporary(const std::string& path, std::string* tmp) {
       return fd;
     }
     if (errno != EEXIST) {
-      throw MapIoError("cannot create a temporary map file '" + name + "': " + errnoText());
+      throw MapIoError("cannot create a temporary file '" + name + "': " + errnoText());
     }
   }
-  throw MapIoError("cannot create a temporary map file beside '" + path +
+  throw MapIoError("cannot create a temporary file beside '" + path +
                    "': " + std::to_string(kAttempts) + " names taken");
 }
 
-void writeAll(int fd, const std::vector<unsigned char>& data, const std::string& name) {
+void writeAll(int fd, const unsigned char* data, std::size_t size, const std::string& name) {
   std::size_t done = 0;
-  while (done < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+  while (done < size) {
+    const ssize_t n = ::write(fd, data + done, size - done);
     if (n < 0) {
       if (errno == EINTR) continue;
-      throw MapIoError("cannot write map file '" + name + "': " + errnoText());
+      throw MapIoError("cannot write file '" + name + "': " + errnoText());
     }
     done += static_cast<std::size_t>(n);
   }
@@ -75,34 +76,44 @@ void writeAll(int fd, const std::vector<unsigned char>& data, const std::string&
 }  // namespace
 
 void writeFileAtomically(const std::string& path, const std::vector<unsigned char>& data) {
+  wavog::writeFileAtomically(path, data.data(), data.size());
+}
+
+}  // namespace detail
+
+void writeFileAtomically(const std::string& path, const void* data, std::size_t size) {
   std::string tmp;
-  const int fd = createTemporary(path, &tmp);
+  const int fd = detail::createTemporary(path, &tmp);
   try {
-    writeAll(fd, data, tmp);
-    if (::fsync(fd) != 0) throw MapIoError("cannot sync map file '" + tmp + "': " + errnoText());
+    detail::writeAll(fd, static_cast<const unsigned char*>(data), size, tmp);
+    if (::fsync(fd) != 0) {
+      throw MapIoError("cannot sync file '" + tmp + "': " + detail::errnoText());
+    }
   } catch (...) {
     ::close(fd);
     ::unlink(tmp.c_str());
     throw;
   }
   if (::close(fd) != 0) {
-    const std::string why = errnoText();
+    const std::string why = detail::errnoText();
     ::unlink(tmp.c_str());
-    throw MapIoError("cannot write map file '" + tmp + "': " + why);
+    throw MapIoError("cannot write file '" + tmp + "': " + why);
   }
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = errnoText();
+    const std::string why = detail::errnoText();
     ::unlink(tmp.c_str());
     throw MapIoError("cannot rename '" + tmp + "' to '" + path + "': " + why);
   }
   // Makes the rename itself durable. Some file systems cannot sync a directory; the map is
   // complete on disk either way, so that is not an error.
-  const int dir = ::open(directoryOf(path).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  const int dir = ::open(detail::directoryOf(path).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir >= 0) {
     (void)::fsync(dir);
     ::close(dir);
   }
 }
+
+namespace detail {
 
 RegularFile::RegularFile(const std::string& path) : path_(path) {
   // O_NONBLOCK: opening a FIFO without a writer (or a device waiting for a carrier) returns at

@@ -12,10 +12,7 @@
 namespace wavog {
 namespace detail {
 
-/// Writes `data` to `path` through a new temporary file in the same directory, created
-/// exclusively (O_CREAT | O_EXCL: never an existing file, never through a symlink), synced to
-/// disk, then renamed over `path` (and the directory synced). The file on disk is at every moment
-/// either the old one or the complete new one. The temporary is removed on failure.
+/// wavog::writeFileAtomically (wavog_mapping/core/atomic_file.h) for a map file's bytes.
 void writeFileAtomically(const std::string& path, const std::vector<unsigned char>& data);
 
 /// An open regular file, read by position. Opening never blocks (a FIFO without a writer, a

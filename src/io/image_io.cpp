@@ -1,6 +1,10 @@
 // PNG / PGM / map_server YAML writers (and small readers for tests and tools). PNG goes through
-// libpng's simplified API (8-bit grey or RGB); PGM and the YAML are written here.
+// libpng's simplified API (8-bit grey or RGB); PGM and the YAML are written here. Every file is
+// written whole through wavog::writeFileAtomically: never through a symlink planted at its name,
+// never half-written.
 #include "wavog_mapping/io/image_io.h"
+
+#include "wavog_mapping/core/atomic_file.h"
 
 #include <png.h>
 
@@ -17,6 +21,7 @@
 #include <iterator>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace wavog {
 namespace {
@@ -35,13 +40,9 @@ void checkImage(const std::string& path, const Image& image) {
   }
 }
 
-/// Writes `data` to `path` in one go; throws naming the file on failure.
+/// Writes `data` to `path` (wavog::writeFileAtomically); throws naming the file on failure.
 void writeFile(const std::string& path, const std::string& data) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing: " + std::strerror(errno));
-  out.write(data.data(), static_cast<std::streamsize>(data.size()));
-  out.close();
-  if (!out) throw std::runtime_error(path + ": write failed: " + std::strerror(errno));
+  writeFileAtomically(path, data.data(), data.size());
 }
 
 std::string readFile(const std::string& path) {
@@ -127,11 +128,22 @@ void writePng(const std::string& path, const Image& image) {
   png.width = static_cast<png_uint_32>(image.width);
   png.height = static_cast<png_uint_32>(image.height);
   png.format = image.channels == 1 ? PNG_FORMAT_GRAY : PNG_FORMAT_RGB;
-  if (!png_image_write_to_file(&png, path.c_str(), 0, image.pixels.data(), 0, nullptr)) {
+  // Encoded in memory (first the size, then the bytes), then written as every other file.
+  png_alloc_size_t size = 0;
+  std::vector<unsigned char> encoded;
+  if (png_image_write_to_memory(&png, nullptr, &size, 0, image.pixels.data(), 0, nullptr)) {
+    encoded.resize(size);
+    if (!png_image_write_to_memory(&png, encoded.data(), &size, 0, image.pixels.data(), 0,
+                                   nullptr)) {
+      size = 0;
+    }
+  }
+  if (size == 0) {
     const std::string why = png.message;
     png_image_free(&png);
     throw std::runtime_error(path + ": cannot write the PNG: " + why);
   }
+  writeFileAtomically(path, encoded.data(), size);
 }
 
 void writePgm(const std::string& path, const Image& image) {

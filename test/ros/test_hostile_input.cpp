@@ -17,7 +17,10 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -267,7 +270,14 @@ TEST_F(Hostile, SaveMapOnlyBelowMapDir) {
     EXPECT_TRUE(save.response.files.empty());
   }
   ::unlink(link.c_str());
-  // A relative name resolves below map_dir (/tmp).
+  // A relative name resolves below map_dir (/tmp). Symlinks planted at the names of the
+  // map_server files beside it are replaced, never written through.
+  const std::string victim = "/tmp/wavog_hostile_victim_" + pid;
+  std::ofstream(victim) << "victim\n";
+  const std::string stem = "/tmp/wavog_hostile_" + pid;
+  for (const std::string name : {stem + "_s0.pgm", stem + "_s0.yaml", stem + "_s2.pgm"}) {
+    ASSERT_EQ(::symlink(victim.c_str(), name.c_str()), 0) << name;
+  }
   wavog_mapping::SaveMap save;
   save.request.path = "wavog_hostile_" + pid + ".wavog";
   ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", save));
@@ -276,7 +286,20 @@ TEST_F(Hostile, SaveMapOnlyBelowMapDir) {
   EXPECT_EQ(save.response.files[0], "/tmp/wavog_hostile_" + pid + ".wavog");
   struct stat st {};
   EXPECT_EQ(::stat(save.response.files[0].c_str(), &st), 0);
+  std::ifstream in(victim);
+  const std::string victim_now((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(victim_now, "victim\n") << "save_map wrote through a symlink";
+  const auto& files = save.response.files;
+  ASSERT_NE(std::find(files.begin(), files.end(), stem + "_s0.pgm"), files.end());
+  for (const std::string name : {stem + "_s0.pgm", stem + "_s0.yaml", stem + "_s2.pgm"}) {
+    if (std::find(files.begin(), files.end(), name) != files.end()) {
+      EXPECT_EQ(::lstat(name.c_str(), &st), 0) << name;
+      EXPECT_TRUE(S_ISREG(st.st_mode)) << name << " is still a symlink";
+    }
+    std::remove(name.c_str());
+  }
   for (const auto& f : save.response.files) std::remove(f.c_str());
+  std::remove(victim.c_str());
 }
 
 TEST(HostileStartUp, MapFileNotARegularFileFailsAtOnce) {

@@ -203,6 +203,32 @@ TEST_F(ImageIo, PgmAndMapServerYaml) {
   }
 }
 
+TEST_F(ImageIo, NeverWritesThroughASymlinkPlantedAtTheNames) {
+  // Files outside the target directory, and symlinks to them at each name the writers use.
+  const fs::path outside = dir_ / "outside";
+  fs::create_directories(outside);
+  const std::string kept = "not to be overwritten\n";
+  for (const std::string name : {"map_s1.pgm", "map_s1.yaml", "map_s1.png"}) {
+    std::ofstream(outside / name) << kept;
+    fs::create_symlink(outside / name, dir_ / name);
+  }
+  const wavog::Raster r = sample();
+  wavog::writeMapServerMap(path("map_s1"), r);
+  wavog::writePng(path("map_s1.png"), wavog::renderRgb(r));
+  for (const std::string name : {"map_s1.pgm", "map_s1.yaml", "map_s1.png"}) {
+    SCOPED_TRACE(name);
+    EXPECT_EQ(readText((outside / name).string()), kept);
+    EXPECT_FALSE(fs::is_symlink(dir_ / name));  // the link itself was replaced by the new file
+    EXPECT_TRUE(fs::is_regular_file(dir_ / name));
+  }
+  EXPECT_EQ(wavog::readPgm(path("map_s1.pgm")).pixels, wavog::renderGrey(r).pixels);
+  EXPECT_EQ(wavog::readPng(path("map_s1.png")).pixels, wavog::renderRgb(r).pixels);
+  // No temporary is left beside them.
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir_)) files += e.is_directory() ? 0 : 1;
+  EXPECT_EQ(files, 3u);
+}
+
 TEST_F(ImageIo, ErrorsNameTheFile) {
   const wavog::Image img(2, 2, 1);
   const std::string bad = path("no/such/dir/x.png");
