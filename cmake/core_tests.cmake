@@ -13,31 +13,35 @@ target_compile_definitions(wavog_test_support PUBLIC
 
 # `core_tests` builds every core test (make test-asan builds only these).
 add_custom_target(core_tests)
+# wavog_core_test(<name> [REAL_DATA <file>...]): with REAL_DATA, the tests named RealData* (gtest
+# filter *.RealData*) read those files of the data directory and run as a second ctest entry,
+# core_<name>_real_data, registered only where the files are found (cmake/real_data.cmake).
 function(wavog_core_test name)
+  cmake_parse_arguments(ARG "" "" "REAL_DATA" ${ARGN})
   add_executable(${name} test/core/${name}.cpp)
   add_dependencies(core_tests ${name})
   target_link_libraries(${name} PRIVATE wavog_test_support GTest::Main)
   target_compile_options(${name} PRIVATE ${WAVOG_WARNINGS})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
-  add_test(NAME core_${name} COMMAND ${name} --gtest_output=xml:${CMAKE_BINARY_DIR}/test_results/core/${name}.xml)
-  set_tests_properties(core_${name} PROPERTIES LABELS "core" TIMEOUT 900)
+  wavog_add_gtest(core_${name} ${name} ${CMAKE_BINARY_DIR}/test_results/core core 900
+                  "${ARG_REAL_DATA}")
 endfunction()
 
 wavog_core_test(test_haar)
 wavog_core_test(test_params)
-wavog_core_test(test_reference_equivalence)
+wavog_core_test(test_reference_equivalence REAL_DATA fr079-corrected.log.gz)
 wavog_core_test(test_lazy_forgetting)
 wavog_core_test(test_forget_half_life)
-wavog_core_test(test_reflection)
+wavog_core_test(test_reflection REAL_DATA fr079-corrected.log.gz)
 wavog_core_test(test_cell_runs)
-wavog_core_test(test_ndt)
+wavog_core_test(test_ndt REAL_DATA fr079-corrected.log.gz)
 wavog_core_test(test_readout)
 wavog_core_test(test_map_io)
 wavog_core_test(test_save_crash_safety)
-wavog_core_test(test_carmen_reader)
+wavog_core_test(test_carmen_reader REAL_DATA fr079-corrected.log.gz csail-robotlaser1.log.gz)
 wavog_core_test(test_motion_compensation)
 wavog_core_test(test_scan_classifier)
 wavog_core_test(test_integrate_stats)
 wavog_core_test(test_defaults)
-wavog_core_test(test_parallel_integration)
+wavog_core_test(test_parallel_integration REAL_DATA fr079-corrected.log.gz)
 wavog_core_test(test_limits)

@@ -34,3 +34,28 @@ function(wavog_real_data_found out_var test_name)
   file(APPEND ${WAVOG_REAL_DATA_MISSING_FILE} "${test_name} (needs ${_list})\n")
   set(${out_var} FALSE PARENT_SCOPE)
 endfunction()
+
+# wavog_add_gtest(<test> <executable> <xml dir> <label> <timeout> "<real data files>"): registers a
+# gtest executable. With real data files, its RealData* tests are a second entry <test>_real_data,
+# registered where the files are found; the first entry runs every other test. A filter that
+# selects no test fails (a renamed test must not silently drop out).
+function(wavog_add_gtest test exe xml_dir label timeout real_data)
+  if(real_data STREQUAL "")
+    add_test(NAME ${test} COMMAND ${exe} --gtest_output=xml:${xml_dir}/${exe}.xml
+             WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
+    set_tests_properties(${test} PROPERTIES LABELS "${label}" TIMEOUT ${timeout})
+    return()
+  endif()
+  add_test(NAME ${test} COMMAND ${exe} --gtest_filter=-*.RealData*
+           --gtest_output=xml:${xml_dir}/${exe}.xml WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
+  set_tests_properties(${test} PROPERTIES LABELS "${label}" TIMEOUT ${timeout}
+                       FAIL_REGULAR_EXPRESSION "Running 0 tests from")
+  wavog_real_data_found(_found ${test}_real_data ${real_data})
+  if(_found)
+    add_test(NAME ${test}_real_data COMMAND ${exe} --gtest_filter=*.RealData*
+             --gtest_output=xml:${xml_dir}/${exe}_real_data.xml WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
+    set_tests_properties(${test}_real_data PROPERTIES LABELS "${label};real_data"
+                         TIMEOUT ${timeout} FAIL_REGULAR_EXPRESSION "Running 0 tests from"
+                         ENVIRONMENT "WAVOG_DATA_DIR=${WAVOG_DATA_DIR}")
+  endif()
+endfunction()

@@ -1,12 +1,8 @@
 # Offline tools (issue 4): wavog_log2bag (CARMEN log -> rosbag) and wavog_offline (bag or CARMEN
 # log -> maps, no roscore), with their tests (ctest label "tools"). Included when ROS is built.
 set(WAVOG_TOOLS_BIN_DIR ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
-# The shared data the tool tests read: $WAVOG_DATA_DIR, else ../shared/data beside the repository.
-if(DEFINED ENV{WAVOG_DATA_DIR})
-  set(_wavog_data_dir $ENV{WAVOG_DATA_DIR})
-else()
-  get_filename_component(_wavog_data_dir ${CMAKE_CURRENT_SOURCE_DIR}/../shared/data ABSOLUTE)
-endif()
+# The shared data the tool tests read: WAVOG_DATA_DIR (cmake/real_data.cmake).
+set(_wavog_data_dir ${WAVOG_DATA_DIR})
 
 add_executable(wavog_log2bag src/tools/log2bag.cpp)
 target_include_directories(wavog_log2bag SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -25,16 +21,17 @@ endif()
 # ---- Tests: plain gtest executables (built by `make`, unlike catkin_add_gtest) run by ctest ----
 find_package(GTest REQUIRED)
 
+# wavog_tools_test(<name> [REAL_DATA <file>...]): as wavog_core_test (cmake/core_tests.cmake).
 function(wavog_tools_test name)
-  add_executable(${name} test/tools/${name}.cpp ${ARGN})
-  target_link_libraries(${name} PRIVATE wavog_tool_support GTest::GTest GTest::Main)
+  cmake_parse_arguments(ARG "" "" "REAL_DATA" ${ARGN})
+  add_executable(${name} test/tools/${name}.cpp)
+  target_link_libraries(${name} PRIVATE wavog_tool_support GTest::GTest GTest::Main ZLIB::ZLIB)
   target_compile_options(${name} PRIVATE ${WAVOG_WARNINGS})
   target_compile_definitions(${name} PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  target_include_directories(${name} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/test/core)  # synthetic_log.h
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
-  add_test(NAME tools_${name}
-           COMMAND ${name} --gtest_output=xml:${CMAKE_BINARY_DIR}/test_results/tools/${name}.xml
-           WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
-  set_tests_properties(tools_${name} PROPERTIES LABELS "tools" TIMEOUT 300)
+  wavog_add_gtest(tools_${name} ${name} ${CMAKE_BINARY_DIR}/test_results/tools tools 300
+                  "${ARG_REAL_DATA}")
 endfunction()
 
 wavog_tools_test(test_image_io)
@@ -45,7 +42,7 @@ wavog_tools_test(test_tool_support)
 wavog_tools_test(test_ndt_image)
 
 if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_log2bag.cpp)
-  wavog_tools_test(test_log2bag)
+  wavog_tools_test(test_log2bag REAL_DATA fr079-corrected.log.gz csail-robotlaser1.log.gz)
   target_include_directories(test_log2bag SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(test_log2bag PRIVATE ${catkin_LIBRARIES})
   target_compile_definitions(test_log2bag PRIVATE WAVOG_LOG2BAG="$<TARGET_FILE:wavog_log2bag>")
@@ -53,7 +50,7 @@ if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_log2bag.cpp)
 endif()
 
 if(TARGET wavog_offline AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/test_offline.cpp)
-  wavog_tools_test(test_offline)
+  wavog_tools_test(test_offline REAL_DATA fr079-corrected.log.gz laser_scan_matcher_demo.bag)
   target_include_directories(test_offline SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(test_offline PRIVATE wavog_ros ${catkin_LIBRARIES})
   target_compile_definitions(test_offline PRIVATE
@@ -65,7 +62,8 @@ endif()
 # through launch/playback.launch into the node, compared with wavog_offline's map.
 if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
    AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/playback.test)
-  if(EXISTS ${_wavog_data_dir}/fr079-corrected.log.gz)
+  wavog_real_data_found(_wavog_have_fr079 rostest_playback.test fr079-corrected.log.gz)
+  if(_wavog_have_fr079)
     find_package(rostest REQUIRED)
     add_executable(test_playback test/tools/test_playback.cpp)
     target_include_directories(test_playback SYSTEM PRIVATE ${catkin_INCLUDE_DIRS}
@@ -88,9 +86,6 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
     set_tests_properties(_ctest_${PROJECT_NAME}_rostest_test_tools_playback.test PROPERTIES
                          FIXTURES_REQUIRED wavog_playback_bag LABELS "tools;rostest" TIMEOUT 300
                          ENVIRONMENT "WAVOG_PLAYBACK_BAG=${_wavog_playback_bag}")
-  else()
-    message(STATUS "wavog tools: ${_wavog_data_dir}/fr079-corrected.log.gz not found; "
-                   "playback rostest not registered (set WAVOG_DATA_DIR)")
   endif()
 endif()
 
@@ -99,7 +94,8 @@ endif()
 if(CATKIN_ENABLE_TESTING AND TARGET wavog_mapping_node
    AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/real_bag.test)
   set(_wavog_real_bag ${_wavog_data_dir}/laser_scan_matcher_demo.bag)
-  if(EXISTS ${_wavog_real_bag})
+  wavog_real_data_found(_wavog_have_lsm rostest_real_bag.test laser_scan_matcher_demo.bag)
+  if(_wavog_have_lsm)
     find_package(rostest REQUIRED)
     add_executable(test_real_bag test/tools/test_real_bag.cpp)
     target_include_directories(test_real_bag SYSTEM PRIVATE ${catkin_INCLUDE_DIRS}
@@ -112,8 +108,6 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_mapping_node
     set_tests_properties(_ctest_${PROJECT_NAME}_rostest_test_tools_real_bag.test PROPERTIES
                          LABELS "tools;rostest" TIMEOUT 200
                          ENVIRONMENT "WAVOG_REAL_BAG=${_wavog_real_bag}")
-  else()
-    message(STATUS "wavog tools: ${_wavog_real_bag} not found; real-bag rostest not registered")
   endif()
 endif()
 

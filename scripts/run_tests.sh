@@ -25,4 +25,16 @@ if [ -z "${total:-}" ]; then
   exit 1
 fi
 echo "$((total - failed)) passed, ${failed} failed"
+# The real-data tests this build left out (cmake/real_data.cmake): say so on the last lines.
+missing_list=$build/real_data_missing.txt
+if [ -s "$missing_list" ]; then
+  n_missing=$(wc -l <"$missing_list")
+  echo "${n_missing} real-data test(s) did not run: their logs and bags were not found (WAVOG_DATA_DIR, else ../shared/data beside the repository):"
+  sed 's/^/  /' "$missing_list"
+  echo "To run them, put the public data sets there (README, 'Test data': where to get each) and run make test again."
+  if [ "${WAVOG_REQUIRE_DATA:-0}" = 1 ]; then
+    echo "WAVOG_REQUIRE_DATA=1: every real-data test must run"
+    exit 1
+  fi
+fi
 [ "$status" -eq 0 ] && [ "$failed" -eq 0 ]

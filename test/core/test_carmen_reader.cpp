@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "synthetic_log.h"
 #include "wavog_mapping/io/carmen_reader.h"
 
 namespace {
@@ -130,7 +131,7 @@ std::string catchMessage(const std::string& path, bool strict, std::size_t* line
   return "";
 }
 
-TEST(CarmenReader, ReadsFr079FlaserScans) {
+TEST(CarmenReader, RealDataReadsFr079FlaserScans) {
   const std::string path = dataFile("fr079-corrected.log.gz");
   ASSERT_FALSE(path.empty()) << "shared data not found: set WAVOG_DATA_DIR";
   wavog::CarmenReader reader(path);
@@ -169,7 +170,7 @@ TEST(CarmenReader, ReadsFr079FlaserScans) {
   EXPECT_DOUBLE_EQ(v.range_max, 80.0);
 }
 
-TEST(CarmenReader, ReadsCsailRobotLaser1Scans) {
+TEST(CarmenReader, RealDataReadsCsailRobotLaser1Scans) {
   const std::string path = dataFile("csail-robotlaser1.log.gz");
   ASSERT_FALSE(path.empty()) << "shared data not found: set WAVOG_DATA_DIR";
   const std::vector<wavog::CarmenScan> scans = wavog::readCarmenLog(path);
@@ -369,11 +370,9 @@ TEST(CarmenReader, LenientModeSkipsAndRecordsMalformedLines) {
 
 TEST(CarmenReader, TruncatedGzipIsAClearError) {
   TempDir tmp;
-  const std::string src = dataFile("fr079-corrected.log.gz");
-  ASSERT_FALSE(src.empty()) << "shared data not found: set WAVOG_DATA_DIR";
-  const std::string bytes = readBytes(src);
-  ASSERT_GT(bytes.size(), 200000u);
-  const std::string path = tmp.file("cut.log.gz", bytes.substr(0, 150000));
+  const std::string bytes = wavog_test::gzipDeflate(wavog_test::syntheticFlaserLog(400));
+  ASSERT_GT(bytes.size(), 100000u);
+  const std::string path = tmp.file("cut.log.gz", bytes.substr(0, bytes.size() / 2));
   const std::string msg = catchMessage(path, false);
   EXPECT_NE(msg.find("runtime_error: " + path + ": truncated gzip stream"), std::string::npos)
       << msg;

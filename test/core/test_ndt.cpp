@@ -109,7 +109,7 @@ TEST(Ndt, RandomScansEveryPolicyAndPriorEveryScale) {
   }
 }
 
-TEST(Ndt, Fr079First500ScansEveryPolicy) {
+TEST(Ndt, RealDataFr079First500ScansEveryPolicy) {
   const std::vector<OwnedScan> log = fr079Scans(500);
   ASSERT_EQ(log.size(), 500u);
   const CellBox extent{-600, -600, 600, 600};

@@ -136,7 +136,7 @@ TEST(ParallelIntegration, RandomScansGiveTheSameMapForOneTwoAndFourThreads) {
   }
 }
 
-TEST(ParallelIntegration, Fr079First500ScansGiveTheSameMapForOneTwoAndFourThreads) {
+TEST(ParallelIntegration, RealDataFr079First500ScansGiveTheSameMapForOneTwoAndFourThreads) {
   const std::string dir = dataDir();
   ASSERT_FALSE(dir.empty());
   const auto log = wavog::readCarmenLog(dir + "/fr079-corrected.log.gz", 500);

@@ -181,7 +181,7 @@ TEST(ReferenceEquivalence, SectorBoundariesThroughCellCentres) {
 }
 
 // (b) The first 500 scans of the Freiburg fr079 log.
-TEST(ReferenceEquivalence, Fr079First500Scans) {
+TEST(ReferenceEquivalence, RealDataFr079First500Scans) {
   const std::vector<OwnedScan> log = fr079Scans(500);
   ASSERT_EQ(log.size(), 500u);
   const double res = 0.1;

@@ -263,7 +263,7 @@ TEST(Reflection, PolicyChangesRestartItExactly) {
   }
 }
 
-TEST(Reflection, Fr079FirstScansEveryPolicy) {
+TEST(Reflection, RealDataFr079FirstScansEveryPolicy) {
   const std::vector<OwnedScan> log = fr079Scans(500);
   ASSERT_EQ(log.size(), 500u);
   // The area of the first scans (fr079's first poses are near the origin, ranges < 50 m).

@@ -24,6 +24,7 @@
 
 #include "../ros/driving_laser.h"
 #include "program_runner.h"
+#include "synthetic_log.h"
 #include "wavog_mapping/core/motion_compensation.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
@@ -114,7 +115,7 @@ std::string OfflineFr079::bag_;
 std::string OfflineFr079::out_;
 RunResult OfflineFr079::bag_run_;
 
-TEST_F(OfflineFr079, BagMapEqualsTheCoreMapFromTheLog) {
+TEST_F(OfflineFr079, RealDataBagMapEqualsTheCoreMapFromTheLog) {
   ASSERT_FALSE(log_.empty()) << "shared data not found: set WAVOG_DATA_DIR";
   ASSERT_EQ(bag_run_.status, 0) << bag_run_.err;
   const wavog::MapParams params = defaultParams();
@@ -182,7 +183,7 @@ TEST_F(OfflineFr079, BagMapEqualsTheCoreMapFromTheLog) {
             << exact.known_mismatch + exact.value_mismatch << " mismatches\n";
 }
 
-TEST_F(OfflineFr079, WritesPicturesMapServerFilesSummaryAndSnapshots) {
+TEST_F(OfflineFr079, RealDataWritesPicturesMapServerFilesSummaryAndSnapshots) {
   ASSERT_FALSE(log_.empty());
   ASSERT_EQ(bag_run_.status, 0) << bag_run_.err;
   const fs::path out(out_);
@@ -223,7 +224,7 @@ TEST_F(OfflineFr079, WritesPicturesMapServerFilesSummaryAndSnapshots) {
   EXPECT_TRUE(fs::exists(out / "snapshots" / "t00000.0_s0.png"));
 }
 
-TEST_F(OfflineFr079, CarmenLogDirectlyWithPolicyAndScaleOptions) {
+TEST_F(OfflineFr079, RealDataCarmenLogDirectlyWithPolicyAndScaleOptions) {
   ASSERT_FALSE(log_.empty());
   const std::string out = (workDir() / "fr079_log").string();
   const RunResult r = run(WAVOG_OFFLINE,
@@ -250,7 +251,7 @@ TEST_F(OfflineFr079, CarmenLogDirectlyWithPolicyAndScaleOptions) {
   EXPECT_EQ(d.known_mismatch + d.value_mismatch, 0u) << d.known_mismatch << " " << d.value_mismatch;
 }
 
-TEST(OfflineNdt, PicturesAndCountsOfTheGaussiansPerScaleEqualTheCoreMaps) {
+TEST(OfflineNdt, RealDataPicturesAndCountsOfTheGaussiansPerScaleEqualTheCoreMaps) {
   const std::string log = dataFile("fr079-corrected.log.gz");
   ASSERT_FALSE(log.empty()) << "shared data not found: set WAVOG_DATA_DIR";
   constexpr std::size_t kNdtScans = 150;
@@ -319,7 +320,7 @@ TEST(OfflineNdt, PicturesAndCountsOfTheGaussiansPerScaleEqualTheCoreMaps) {
   }
 }
 
-TEST(Offline, LaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) {
+TEST(Offline, RealDataLaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) {
   const std::string bag = dataFile("laser_scan_matcher_demo.bag");
   ASSERT_FALSE(bag.empty()) << "shared data not found: set WAVOG_DATA_DIR";
   // Without tf the default fixed frame "map" never connects: a clear error listing the frames.
@@ -412,11 +413,8 @@ TEST(Offline, UpsideDownLaserAndMotionCompensationInABag) {
 }
 
 TEST(Offline, TruncatedGzipLogIsReportedAfterMappingWhatWasRead) {
-  const std::string src = dataFile("fr079-corrected.log.gz");
-  ASSERT_FALSE(src.empty());
-  std::ifstream in(src, std::ios::binary);
-  std::string bytes(120000, '\0');  // about 270 scans
-  in.read(&bytes[0], static_cast<std::streamsize>(bytes.size()));
+  const std::string whole = wavog_test::gzipDeflate(wavog_test::syntheticFlaserLog(400));
+  const std::string bytes = whole.substr(0, whole.size() / 2);  // about 200 scans
   const std::string cut = (workDir() / "cut.log.gz").string();
   std::ofstream(cut, std::ios::binary) << bytes;
   const std::string out = (workDir() / "cut").string();
@@ -436,12 +434,17 @@ TEST(Offline, ClearErrors) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find(missing + ": cannot open"), std::string::npos) << r.err;
 
-  const std::string bag = dataFile("laser_scan_matcher_demo.bag");
-  ASSERT_FALSE(bag.empty());
-  r = run(WAVOG_OFFLINE, "--no-progress --topics front_laser/scan -o " + out + " " + bag);
+  // A bag of 50 scans on /front_laser/scan, from a log made here.
+  const std::string log = (workDir() / "errors.log").string();
+  std::ofstream(log) << wavog_test::syntheticFlaserLog(50);
+  const std::string bag = (workDir() / "errors.bag").string();
+  const RunResult c = run(WAVOG_LOG2BAG, "--quiet " + log + " " + bag);
+  ASSERT_EQ(c.status, 0) << c.err;
+  r = run(WAVOG_OFFLINE, "--no-progress --topics rear_laser/scan -o " + out + " " + bag);
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.err.find("the bag has no topic 'front_laser/scan'"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("/scan (sensor_msgs/LaserScan, 360 msgs)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the bag has no topic 'rear_laser/scan'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/front_laser/scan (sensor_msgs/LaserScan, 50 msgs)"), std::string::npos)
+      << r.err;
 
   r = run(WAVOG_OFFLINE, "--no-progress --policy sometimes -o " + out + " " + bag);
   EXPECT_EQ(r.status, 1);
