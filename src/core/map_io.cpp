@@ -36,6 +36,7 @@
 #include "map_codec.h"
 #include "map_file.h"
 #include "map_impl.h"
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
@@ -83,6 +84,14 @@ void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
   }
 }
 
+// The refusal of a log-odds the update cannot carry (limits.h, kMaxStoredLogOdds).
+std::string beyondBound(const char* what, double value) {
+  std::ostringstream s;
+  s << what << " of " << value << " log-odds, beyond the +-" << kMaxStoredLogOdds
+    << " an update keeps finite";
+  return s.str();
+}
+
 // How a file's pending counts are read: their width and the factor one unit stands for.
 struct PendingFormat {
   std::uint32_t version;
@@ -99,6 +108,7 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
   for (float& d : n.d) {
     d = r->get<float>();
     if (!std::isfinite(d)) throw std::runtime_error("non-finite detail");
+    if (std::fabs(d) > kMaxStoredLogOdds) throw std::runtime_error(beyondBound("a detail", d));
   }
   const unsigned k = f.version == 1 ? r->get<std::uint8_t>() : r->get<std::uint16_t>();
   if (f.same_unit && pending == 0 && k <= impl.k_cap) {
@@ -201,6 +211,9 @@ void readBlocks(WaveletMap::Impl& fresh, const PendingFormat& format, std::size_
     const auto s = r->get<double>();
     const auto flags = r->get<std::uint8_t>();
     if (!std::isfinite(s) || flags > 7) throw std::runtime_error("bad block header");
+    if (std::fabs(s) > kMaxStoredLogOdds) {
+      throw std::runtime_error(beyondBound("a block average", s));
+    }
     if (!inExtent(detail::scaleUp(bx, fresh.levels), detail::scaleUp(by, fresh.levels))) {
       throw std::runtime_error("block (" + std::to_string(bx) + ", " + std::to_string(by) +
                                ") outside the representable extent of +-2^30 cells");
