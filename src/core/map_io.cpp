@@ -268,7 +268,37 @@ void WaveletMap::save(const std::string& path) const {
   detail::writeFileAtomically(path, buf);
 }
 
-void WaveletMap::load(const std::string& path) {
+void WaveletMap::load(const std::string& path) { load(path, nullptr); }
+
+MapFileContents WaveletMap::inspectFile(const std::string& path) {
+  // The grid from the header (load() checks the rest), then a load keeping both payloads.
+  MapParams p;
+  {
+    const detail::RegularFile file(path);
+    const auto head = file.read(0, static_cast<std::size_t>(
+                                       std::min<std::uint64_t>(file.size(), kHeaderBytes)));
+    if (head.size() < kHeaderBytes || std::memcmp(head.data(), kMagic, sizeof(kMagic)) != 0) {
+      throw MapIoError("map file '" + path + "' rejected: not a wavog map (bad magic or header)");
+    }
+    std::int32_t levels;
+    std::memcpy(&p.grid.resolution, head.data() + sizeof(kMagic) + 4, sizeof(double));
+    std::memcpy(&levels, head.data() + sizeof(kMagic) + 12, sizeof(levels));
+    p.grid.block_levels = levels;
+  }
+  p.reflection = p.ndt = true;
+  if (!p.validate().empty()) {
+    std::ostringstream s;
+    s << "map file '" << path << "' rejected: its resolution " << p.grid.resolution
+      << " m / block_levels " << p.grid.block_levels << " are outside the valid ranges";
+    throw MapIoError(s.str());
+  }
+  WaveletMap probe(p);
+  MapFileContents contents;
+  probe.load(path, &contents);
+  return contents;
+}
+
+void WaveletMap::load(const std::string& path, MapFileContents* contents) {
   const std::vector<unsigned char> data = readMapFile(path, impl_->levels);
   const auto fail = [&](const std::string& why) {
     return MapIoError("map file '" + path + "' rejected: " + why);
@@ -322,11 +352,18 @@ void WaveletMap::load(const std::string& path) {
       file.mode = ReflectionMode::kLayers;  // the hits and misses of older files
       file.basis = fresh.currentBasis();    // not recorded; the layers count whatever it was
     }
+    const bool held_reflection =
+        file.mode != ReflectionMode::kOff || file_layers[0] != nullptr || file_layers[1] != nullptr;
     if (impl_->params.reflection) {
       fresh.adoptReflection(file.mode, file.basis, std::move(file_layers[0]),
                             std::move(file_layers[1]));
     }
     if (!r.done()) throw std::runtime_error("trailing bytes");
+    if (contents != nullptr) {
+      contents->reflection = held_reflection;
+      contents->ndt = false;  // the Gaussians the file held (kept: inspectFile's map has ndt)
+      for (const auto& kv : fresh.blocks) contents->ndt |= kv.second.ndt && !kv.second.ndt->empty();
+    }
   } catch (const MapIoError&) {
     throw;
   } catch (const std::exception& e) {

@@ -353,5 +353,39 @@ TEST(MapIo, LogOddsTheUpdateCannotCarryAreRefused) {
   std::remove(path.c_str());
 }
 
+// Issue 28, item 5 (core side): a caller configured without reflection or NDT can tell that a
+// file's payload would be dropped.
+TEST(MapIo, InspectFileSaysWhichPayloadsAFileHolds) {
+  const std::string path = tempPath("inspect.wavog");
+  for (int mask = 0; mask < 4; ++mask) {
+    MapParams p = params();
+    p.reflection = (mask & 1) != 0;
+    p.ndt = (mask & 2) != 0;
+    WaveletMap map(p);
+    fill(&map, 13);
+    map.save(path);
+    const wavog::MapFileContents c = WaveletMap::inspectFile(path);
+    EXPECT_EQ(c.reflection, p.reflection) << mask;
+    EXPECT_EQ(c.ndt, p.ndt) << mask;
+    // A map without them drops them: its own save holds neither.
+    WaveletMap plain(params());
+    plain.load(path);
+    plain.save(path);
+    const wavog::MapFileContents dropped = WaveletMap::inspectFile(path);
+    EXPECT_FALSE(dropped.reflection || dropped.ndt) << mask;
+  }
+  // Older versions: the version-2 fixture's reflection layers, the version-1 fixture's nothing.
+  const std::string data = std::string(WAVOG_SOURCE_DIR) + "/test/core/data/";
+  const wavog::MapFileContents v2 = WaveletMap::inspectFile(data + "reflection_v2.wavog");
+  EXPECT_TRUE(v2.reflection);
+  EXPECT_FALSE(v2.ndt);
+  const wavog::MapFileContents v1 = WaveletMap::inspectFile(data + "forget_v1.wavog");
+  EXPECT_FALSE(v1.reflection || v1.ndt);
+  EXPECT_THROW(WaveletMap::inspectFile(tempPath("missing.wavog")), MapIoError);
+  writeAll(path, std::vector<char>(100, 'x'));
+  EXPECT_THROW(WaveletMap::inspectFile(path), MapIoError);
+  std::remove(path.c_str());
+}
+
 }  // namespace
 }  // namespace wavog_test
