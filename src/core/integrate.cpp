@@ -119,8 +119,8 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
                            std::unique_ptr<detail::WorkerPool>* workers, IntegrateStats* st) {
   const MapParams& p = impl.params;
   // Forgetting: gamma per scan, or from the scan's period with forget_half_life.
-  const unsigned units = impl.scanUnits(period);
-  const double a = impl.half_life ? impl.multiplier(units) : impl.a;
+  const std::uint64_t units = impl.scanUnits(period);
+  const double a = impl.half_life ? impl.scanFactor(units) : impl.a;
   const double g = impl.half_life ? 1.0 - a : p.policy.gamma;
   const detail::PolicyConsts pc{p.sensor.odd_occ,
                                 p.sensor.odd_emp,

@@ -6,6 +6,7 @@
 #define WAVOG_MAPPING_SRC_CORE_MAP_IMPL_H_
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 
@@ -49,19 +50,32 @@ struct WaveletMap::Impl {
   double a = 1.0;                 ///< 1 - gamma for "forget", else 1
   double prune_threshold = 1e-6;  ///< effective tau
   /// Pending forgetting (Node::k, ALGORITHM.md 6.3) counts units: one scan's a (a^k, k <= 255)
-  /// without forget_half_life, else 2^-unit_log2 halvings each (2^(-k unit), k < 2^16), so that
+  /// without forget_half_life, else unit_log2 halvings each (2^(-k unit), k < 2^16), so that
   /// scans of different periods add their exponents exactly.
   bool half_life = false;
   double unit_log2 = 0.0;  ///< forget_half_life: halvings per unit
+  /// forget_half_life: a scan of kResolvedPeriod s counts at least kResolvedUnits units (the unit
+  /// is finer than the tau-based 2^-11 for half-lives above 0.8 s at tau = 0).
+  static constexpr double kResolvedPeriod = 0.025, kResolvedUnits = 64.0;
   unsigned k_cap = 255;    ///< largest pending count a node holds (it is flushed beyond)
-  int k_star = 256;        ///< pending count at which a fully-E subtree is negligible (<= k_cap)
+  /// Pending count at which a fully-E subtree is negligible. Without forget_half_life, and with
+  /// the tau-based unit (half-lives up to 0.8 s at tau = 0), at most k_cap; with longer ones (finer units) it may
+  /// exceed k_cap: a subtree is then dropped only by a scan that forgets this much at once.
+  std::uint64_t k_star = 256;
   std::array<double, 256> mult_lo{};  ///< multiplier(k) for k < 256 (a^k: repeated products)
   std::array<double, 256> mult_hi{};  ///< multiplier(256 j)
 
   /// The true value of details stored under k pending units.
   double multiplier(unsigned k) const { return mult_hi[k >> 8] * mult_lo[k & 255u]; }
-  /// Pending units of one scan of `period` s ("forget"; 1 without forget_half_life).
-  unsigned scanUnits(double period) const;
+  /// Pending units of one scan of `period` s ("forget"; 1 without forget_half_life): its
+  /// exponent rounded to the unit, at least 1 (a scan always forgets, so g > 0), at most k_star.
+  /// May exceed k_cap (a long period, or gamma, under a fine unit; see forgetSubtree).
+  std::uint64_t scanUnits(double period) const;
+  /// The factor of `units` pending units: multiplier(units) up to k_cap, else 2^(-units unit).
+  double scanFactor(std::uint64_t units) const {
+    return units <= k_cap ? multiplier(static_cast<unsigned>(units))
+                          : std::exp2(-static_cast<double>(units) * unit_log2);
+  }
   /// The factor a pending count of k stands for, as saved (multiplier(k) = unitFactor()^k).
   double unitFactor() const { return half_life ? std::exp2(-unit_log2) : a; }
 

@@ -36,6 +36,7 @@
 #include "map_codec.h"
 #include "map_file.h"
 #include "map_impl.h"
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
@@ -83,6 +84,14 @@ void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
   }
 }
 
+// The refusal of a log-odds the update cannot carry (limits.h, kMaxStoredLogOdds).
+std::string beyondBound(const char* what, double value) {
+  std::ostringstream s;
+  s << what << " of " << value << " log-odds, beyond the +-" << kMaxStoredLogOdds
+    << " an update keeps finite";
+  return s.str();
+}
+
 // How a file's pending counts are read: their width and the factor one unit stands for.
 struct PendingFormat {
   std::uint32_t version;
@@ -99,6 +108,7 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
   for (float& d : n.d) {
     d = r->get<float>();
     if (!std::isfinite(d)) throw std::runtime_error("non-finite detail");
+    if (std::fabs(d) > kMaxStoredLogOdds) throw std::runtime_error(beyondBound("a detail", d));
   }
   const unsigned k = f.version == 1 ? r->get<std::uint8_t>() : r->get<std::uint16_t>();
   if (f.same_unit && pending == 0 && k <= impl.k_cap) {
@@ -201,6 +211,9 @@ void readBlocks(WaveletMap::Impl& fresh, const PendingFormat& format, std::size_
     const auto s = r->get<double>();
     const auto flags = r->get<std::uint8_t>();
     if (!std::isfinite(s) || flags > 7) throw std::runtime_error("bad block header");
+    if (std::fabs(s) > kMaxStoredLogOdds) {
+      throw std::runtime_error(beyondBound("a block average", s));
+    }
     if (!inExtent(detail::scaleUp(bx, fresh.levels), detail::scaleUp(by, fresh.levels))) {
       throw std::runtime_error("block (" + std::to_string(bx) + ", " + std::to_string(by) +
                                ") outside the representable extent of +-2^30 cells");
@@ -255,7 +268,37 @@ void WaveletMap::save(const std::string& path) const {
   detail::writeFileAtomically(path, buf);
 }
 
-void WaveletMap::load(const std::string& path) {
+void WaveletMap::load(const std::string& path) { load(path, nullptr); }
+
+MapFileContents WaveletMap::inspectFile(const std::string& path) {
+  // The grid from the header (load() checks the rest), then a load keeping both payloads.
+  MapParams p;
+  {
+    const detail::RegularFile file(path);
+    const auto head = file.read(0, static_cast<std::size_t>(
+                                       std::min<std::uint64_t>(file.size(), kHeaderBytes)));
+    if (head.size() < kHeaderBytes || std::memcmp(head.data(), kMagic, sizeof(kMagic)) != 0) {
+      throw MapIoError("map file '" + path + "' rejected: not a wavog map (bad magic or header)");
+    }
+    std::int32_t levels;
+    std::memcpy(&p.grid.resolution, head.data() + sizeof(kMagic) + 4, sizeof(double));
+    std::memcpy(&levels, head.data() + sizeof(kMagic) + 12, sizeof(levels));
+    p.grid.block_levels = levels;
+  }
+  p.reflection = p.ndt = true;
+  if (!p.validate().empty()) {
+    std::ostringstream s;
+    s << "map file '" << path << "' rejected: its resolution " << p.grid.resolution
+      << " m / block_levels " << p.grid.block_levels << " are outside the valid ranges";
+    throw MapIoError(s.str());
+  }
+  WaveletMap probe(p);
+  MapFileContents contents;
+  probe.load(path, &contents);
+  return contents;
+}
+
+void WaveletMap::load(const std::string& path, MapFileContents* contents) {
   const std::vector<unsigned char> data = readMapFile(path, impl_->levels);
   const auto fail = [&](const std::string& why) {
     return MapIoError("map file '" + path + "' rejected: " + why);
@@ -309,11 +352,18 @@ void WaveletMap::load(const std::string& path) {
       file.mode = ReflectionMode::kLayers;  // the hits and misses of older files
       file.basis = fresh.currentBasis();    // not recorded; the layers count whatever it was
     }
+    const bool held_reflection =
+        file.mode != ReflectionMode::kOff || file_layers[0] != nullptr || file_layers[1] != nullptr;
     if (impl_->params.reflection) {
       fresh.adoptReflection(file.mode, file.basis, std::move(file_layers[0]),
                             std::move(file_layers[1]));
     }
     if (!r.done()) throw std::runtime_error("trailing bytes");
+    if (contents != nullptr) {
+      contents->reflection = held_reflection;
+      contents->ndt = false;  // the Gaussians the file held (kept: inspectFile's map has ndt)
+      for (const auto& kv : fresh.blocks) contents->ndt |= kv.second.ndt && !kv.second.ndt->empty();
+    }
   } catch (const MapIoError&) {
     throw;
   } catch (const std::exception& e) {

@@ -38,14 +38,22 @@ void WaveletMap::Impl::configure() {
   half_life = forget && params.policy.forget_half_life > 0.0;
   if (half_life) {
     // The finest unit 2^-e for which the negligible multiplier of the widest odd range (100:
-    // odd_occ <= 50, odd_emp >= -50) still fits a 16-bit count; it depends on tau only, so a
-    // map and its reflection layers share it (and so each scan's factor).
+    // odd_occ <= 50, odd_emp >= -50) still fits a 16-bit count (2^-11 at tau = 0) ...
     constexpr double kMaxCount = 65535.0, kWidestRange = 100.0;
     const double widest = std::log2(2.0 * kWidestRange / prune_threshold);
-    const int e = std::min(16, static_cast<int>(std::floor(std::log2(kMaxCount / widest))));
+    const int e_count = std::min(16, static_cast<int>(std::floor(std::log2(kMaxCount / widest))));
+    // ... or finer, for long half-lives: a scan of kResolvedPeriod counts at least kResolvedUnits
+    // units, so that its rate is within 1 / (2 kResolvedUnits) of the exact one (with 2^-11 a
+    // half-life above 2^11 periods / 2 rounded every scan to 0 units: issue 28). A scan of up to
+    // 65535 units still fits one tag (12.8 s / forget_half_life halvings); a longer one is
+    // applied eagerly (forgetSubtree). Both depend on tau and the half-life only, so a map and
+    // its reflection layers share the unit (and so each scan's factor).
+    const double resolved =
+        std::log2(kResolvedUnits * params.policy.forget_half_life / kResolvedPeriod);
+    const int e = std::max(e_count, static_cast<int>(std::ceil(resolved)));
     unit_log2 = std::ldexp(1.0, -e);
     k_cap = 65535;
-    k_star = std::max(1, static_cast<int>(std::ceil(halvings / unit_log2)));
+    k_star = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(halvings / unit_log2)));
     for (std::size_t j = 0; j < mult_lo.size(); ++j) {
       mult_lo[j] = std::exp2(-static_cast<double>(j) * unit_log2);
       mult_hi[j] = std::exp2(-static_cast<double>(256 * j) * unit_log2);
@@ -69,14 +77,16 @@ void WaveletMap::Impl::configure() {
   }
 }
 
-unsigned WaveletMap::Impl::scanUnits(double period) const {
+std::uint64_t WaveletMap::Impl::scanUnits(double period) const {
   if (!half_life) return 1;
   const double exponent = std::isfinite(period) && period > 0.0
                               ? period / params.policy.forget_half_life
                               : -std::log2(1.0 - params.policy.gamma);  // +inf for gamma 1
   const double units = std::round(exponent / unit_log2);
-  return units >= static_cast<double>(k_star) ? static_cast<unsigned>(k_star)
-                                              : static_cast<unsigned>(units);
+  if (units >= static_cast<double>(k_star)) return k_star;
+  // At least one unit: a scan shorter than half a unit still forgets (g > 0), so it still learns
+  // and never adds an end-point of weight 0 (NDT) or a hit ratio 0 / 0 (reflection).
+  return units < 1.0 ? 1 : static_cast<std::uint64_t>(units);
 }
 
 void WaveletMap::Impl::freeSubtree(detail::NodeStore& store, Node& n) {

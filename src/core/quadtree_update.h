@@ -129,7 +129,17 @@ class Integrator {
       scaleSubtree(*node);
       return;
     }
-    impl_.addPending(*node, pc_.units);
+    if (pc_.units > impl_.k_cap) {
+      // One scan beyond what a tag counts (a fine unit, forget_half_life): negligible at once,
+      // else applied eagerly (stored details scale by a whatever tags they carry).
+      if (pc_.units >= impl_.k_star) {
+        slot.remove();
+      } else {
+        scaleSubtree(*node);
+      }
+      return;
+    }
+    impl_.addPending(*node, static_cast<unsigned>(pc_.units));
     if (node->k >= impl_.k_star) slot.remove();  // section 6.5: subtree negligible
   }
 

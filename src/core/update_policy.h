@@ -5,6 +5,7 @@
 #define WAVOG_MAPPING_SRC_CORE_UPDATE_POLICY_H_
 
 #include <algorithm>
+#include <cstdint>
 
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/types.h"
@@ -17,7 +18,7 @@ namespace detail {
 /// the pending units standing for a in a lazy tag (WaveletMap::Impl::multiplier(units) == a).
 struct PolicyConsts {
   double odd_occ, odd_emp, a, g, lo, hi, unchanged_tol;
-  unsigned units;
+  std::uint64_t units;
 };
 
 /// The value of a cell at log-odds x after an E (cls kEmpty) or O observation.

@@ -28,7 +28,7 @@ double WaveletMap::forgetRate(double period) const {
   const Impl& impl = *impl_;
   if (impl.params.policy.type != PolicyType::kForget) return 0.0;
   if (!impl.half_life) return impl.params.policy.gamma;
-  return 1.0 - impl.multiplier(impl.scanUnits(period));
+  return 1.0 - impl.scanFactor(impl.scanUnits(period));
 }
 
 double WaveletMap::forgetUnit() const { return impl_->unit_log2; }

@@ -163,6 +163,109 @@ TEST(ForgetHalfLife, LasersAt10And40HzForgetACellAtTheSameRatePerSecond) {
             0.2 * range);
 }
 
+// Issue 28, item 2: half-lives above 2^11 scan periods / 2 made each scan's exponent round to 0
+// units (g = 0), so the map stopped learning. Every half-life in the valid range must change it.
+TEST(ForgetHalfLife, LongHalfLivesStillLearn) {
+  // 500 scans at 10 Hz (50 s) of a wall with a half-life of 1,000 s: the closed form
+  // odd_occ (1 - 2^(-50 / 1000)) = 0.119 (the map read 0.0 before).
+  const MapParams p = halfLifeParams(1000.0);
+  const double expected = p.sensor.odd_occ * (1.0 - std::exp2(-50.0 / 1000.0));
+  const double got = cellAfter(p, 0.1, 50.0, 0.0);
+  // Each scan's exponent (1e-4 halvings) is rounded to the unit: within 1 / 128 of it.
+  EXPECT_NEAR(got, expected, expected / 128) << "half-life 1000 s at 10 Hz";
+  // Each scan forgets by its own rate within half a unit, and by at least one unit: never 0.
+  for (double h : {409.7, 1000.0, 1e4, 1e5, 1e6}) {
+    const WaveletMap map(halfLifeParams(h));
+    const double unit = map.forgetUnit();
+    for (double period : {1e-9, 0.001, 0.0125, 0.025, 0.1, 1.0}) {
+      const double g = map.forgetRate(period);
+      EXPECT_GT(g, 0.0) << h << " s, period " << period;
+      const double halvings = -std::log2(1.0 - g);
+      EXPECT_LE(std::fabs(halvings - period / h), std::max(unit / 2, unit - period / h) * 1.0001)
+          << h << " s, period " << period;
+    }
+    // At 40 Hz the rounding is under 1 % of the exact rate.
+    EXPECT_NEAR(map.forgetRate(0.025), 1.0 - std::exp2(-0.025 / h),
+                0.01 * (1.0 - std::exp2(-0.025 / h)))
+        << h;
+  }
+  // The longest valid half-life still moves a cell hit at 40 Hz.
+  EXPECT_GT(cellAfter(halfLifeParams(1e6), 0.025, 2.0, 0.0), 0.0);
+}
+
+// A long half-life has a fine unit: a scan of unknown period (gamma) or of a long one counts more
+// units than a tag holds and is applied eagerly, gamma 1 drops the subtree; the tree still equals
+// the dense reference fed the map's per-scan rates.
+TEST(ForgetHalfLife, FineUnitsEqualReferenceWithLongAndUnknownPeriods) {
+  for (double gamma : {0.3, 1.0}) {
+    SCOPED_TRACE(gamma);
+    MapParams p = halfLifeParams(50.0);
+    p.policy.gamma = gamma;
+    WaveletMap lazy(p);
+    ASSERT_LT(lazy.forgetUnit(), std::ldexp(1.0, -11));  // finer than the tau-based unit
+    // Units of a 40 s scan (0.8 halvings) and of gamma 0.3 (0.51) exceed 65535.
+    ASSERT_GT(-std::log2(1.0 - lazy.forgetRate(0.0)) / lazy.forgetUnit(), 65535.0);
+    const wavog::CellBox extent{-80, -80, 80, 80};
+    DenseReference ref(p, extent);
+    RandomScans scans(5150u, 5.0);
+    const double periods[] = {0.1, 0.0, 40.0, 0.025, 0.1, 1e-7, 0.1};
+    for (int i = 0; i < 70; ++i) {
+      const OwnedScan s = scans.next();
+      wavog::ScanView v = s.view();
+      v.period = periods[i % 7];
+      ref.setGamma(0, lazy.forgetRate(v.period));
+      ref.integrate(s.pose, v);
+      lazy.integrate(s.pose, v);
+    }
+    const Comparison c = compare(lazy, ref);
+    EXPECT_LE(c.max_rel_error, kTolerance) << c.worst_x << ", " << c.worst_y;
+    EXPECT_EQ(c.knowledge_mismatches, 0u);
+  }
+}
+
+// Issue 28, item 1: with NDT (or reflection) and a long half-life each end-point added a Gaussian
+// of weight 0 (a hit ratio 0 / 0); the map saved, and load() refused it ("bad NDT cell count",
+// "non-finite hit ratio").
+TEST(ForgetHalfLife, LongHalfLifeMapsWithPayloadsLoadAgain) {
+  const std::string path = ::testing::TempDir() + "half_life_payload_" + std::to_string(::getpid());
+  for (bool ndt : {true, false}) {
+    SCOPED_TRACE(ndt ? "ndt" : "reflection");
+    MapParams p = halfLifeParams(1000.0);
+    p.ndt = ndt;
+    p.ndt_min_weight = 0.0;  // keep the one end-point's Gaussian (weight g = 6.9e-5)
+    p.reflection = !ndt;
+    WaveletMap map(p);
+    const OwnedScan wall = wallScan(4.0);
+    wavog::ScanView v = wall.view();
+    v.period = 0.1;
+    map.integrate(wall.pose, v);  // one scan into new blocks
+    map.save(path);
+    WaveletMap loaded(p);
+    try {
+      loaded.load(path);
+    } catch (const wavog::MapIoError& e) {
+      ADD_FAILURE() << e.what();
+      continue;
+    }
+    expectSameCells(loaded, map, 50, 0.0);
+    const wavog::CellIndex c = map.cellAt(4.05, 0.0);
+    if (ndt) {
+      wavog::NdtCell a, b;
+      ASSERT_TRUE(map.ndtCell(c, &a));
+      ASSERT_TRUE(loaded.ndtCell(c, &b));
+      EXPECT_GT(a.weight, 0.0);
+      EXPECT_EQ(a.weight, b.weight);
+      EXPECT_EQ(a.mean_x, b.mean_x);
+    } else {
+      const float r = map.reflection(c);
+      EXPECT_TRUE(std::isfinite(r)) << r;
+      EXPECT_EQ(r, loaded.reflection(c));
+      EXPECT_NEAR(r, 1.0f, 1e-3f);  // hit once, never missed
+    }
+  }
+  std::remove(path.c_str());
+}
+
 TEST(ForgetHalfLife, FilesKeepThePendingUnits) {
   const std::string path = ::testing::TempDir() + "half_life_" + std::to_string(::getpid());
   WaveletMap map(halfLifeParams(0.3));

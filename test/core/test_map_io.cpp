@@ -7,6 +7,7 @@
 #include <zlib.h>
 
 #include <cerrno>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -285,6 +286,104 @@ TEST(MapIo, FileSizeIsBoundByTheHeadersBlockCount) {
   writeAll(path, withCount(count, 0));
   target.load(path);
   expectSameMap(source, target);
+  std::remove(path.c_str());
+}
+
+// Issue 28, item 3: a file that passed the CRC and load() with a block average of -1e57 turned
+// non-finite after one ordinary scan (its float details overflowed) and could no longer be saved.
+// The loader refuses log-odds beyond wavog::kMaxStoredLogOdds; at the bound the update stays
+// finite.
+TEST(MapIo, LogOddsTheUpdateCannotCarryAreRefused) {
+  WaveletMap source(params());
+  fill(&source, 12);
+  const std::string path = tempPath("huge_logodds.wavog");
+  source.save(path);
+  const auto bytes = readAll(path);
+  constexpr std::size_t kAverageAt = 8 + 4 + 8 + 4 + 8 + 8 + 8 + 4 + 4;  // block 0's f64 average
+  constexpr std::size_t kFlagsAt = kAverageAt + 8, kDetailAt = kFlagsAt + 1;
+  ASSERT_TRUE(bytes[kFlagsAt] & 4) << "block 0 has no root node";
+  const auto patched = [&](std::size_t at, const void* value, std::size_t size) {
+    std::vector<char> out(bytes.begin(), bytes.end() - 4);
+    std::memcpy(out.data() + at, value, size);
+    const auto crc = static_cast<std::uint32_t>(
+        ::crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
+    const auto* c = reinterpret_cast<const char*>(&crc);
+    out.insert(out.end(), c, c + 4);
+    return out;
+  };
+  RandomScans scans(12, 12.0);
+  const auto s = scans.next();
+  const auto everyValueFinite = [](const WaveletMap& map) {
+    wavog::CellBox box;
+    EXPECT_TRUE(map.bounds(0, &box));
+    const auto r = map.exportScale(0, box, wavog::Aggregation::kMean);
+    std::size_t bad = 0;
+    for (float v : r.log_odds) bad += std::isfinite(v) ? 0 : 1;
+    return bad;
+  };
+  for (double average : {-1e57, 1e57, -1.01e30}) {
+    SCOPED_TRACE(average);
+    writeAll(path, patched(kAverageAt, &average, sizeof(average)));
+    WaveletMap target(params());
+    const std::string why = refusal(&target, path);
+    EXPECT_NE(why.find("beyond"), std::string::npos) << why;
+    if (why.empty()) {  // before the fix: loaded, then NaN after one scan
+      target.integrate(s.pose, s.view());
+      EXPECT_EQ(everyValueFinite(target), 0u);
+    }
+  }
+  const float detail = 3e38f;  // finite, but the update's new details overflow float
+  writeAll(path, patched(kDetailAt, &detail, sizeof(detail)));
+  WaveletMap target(params());
+  EXPECT_NE(refusal(&target, path).find("beyond"), std::string::npos);
+  // At the bound: loads, and scans keep every value finite (and the map saves and loads again).
+  for (double average : {-wavog::kMaxStoredLogOdds, wavog::kMaxStoredLogOdds}) {
+    writeAll(path, patched(kAverageAt, &average, sizeof(average)));
+    WaveletMap at_bound(params());
+    ASSERT_NO_THROW(at_bound.load(path));
+    for (int i = 0; i < 5; ++i) {
+      const auto t = scans.next();
+      at_bound.integrate(t.pose, t.view());
+    }
+    EXPECT_EQ(everyValueFinite(at_bound), 0u);
+    at_bound.save(path);
+    WaveletMap again(params());
+    EXPECT_NO_THROW(again.load(path));
+  }
+  std::remove(path.c_str());
+}
+
+// Issue 28, item 5 (core side): a caller configured without reflection or NDT can tell that a
+// file's payload would be dropped.
+TEST(MapIo, InspectFileSaysWhichPayloadsAFileHolds) {
+  const std::string path = tempPath("inspect.wavog");
+  for (int mask = 0; mask < 4; ++mask) {
+    MapParams p = params();
+    p.reflection = (mask & 1) != 0;
+    p.ndt = (mask & 2) != 0;
+    WaveletMap map(p);
+    fill(&map, 13);
+    map.save(path);
+    const wavog::MapFileContents c = WaveletMap::inspectFile(path);
+    EXPECT_EQ(c.reflection, p.reflection) << mask;
+    EXPECT_EQ(c.ndt, p.ndt) << mask;
+    // A map without them drops them: its own save holds neither.
+    WaveletMap plain(params());
+    plain.load(path);
+    plain.save(path);
+    const wavog::MapFileContents dropped = WaveletMap::inspectFile(path);
+    EXPECT_FALSE(dropped.reflection || dropped.ndt) << mask;
+  }
+  // Older versions: the version-2 fixture's reflection layers, the version-1 fixture's nothing.
+  const std::string data = std::string(WAVOG_SOURCE_DIR) + "/test/core/data/";
+  const wavog::MapFileContents v2 = WaveletMap::inspectFile(data + "reflection_v2.wavog");
+  EXPECT_TRUE(v2.reflection);
+  EXPECT_FALSE(v2.ndt);
+  const wavog::MapFileContents v1 = WaveletMap::inspectFile(data + "forget_v1.wavog");
+  EXPECT_FALSE(v1.reflection || v1.ndt);
+  EXPECT_THROW(WaveletMap::inspectFile(tempPath("missing.wavog")), MapIoError);
+  writeAll(path, std::vector<char>(100, 'x'));
+  EXPECT_THROW(WaveletMap::inspectFile(path), MapIoError);
   std::remove(path.c_str());
 }
 

@@ -73,8 +73,10 @@ struct PolicyParams {
   /// 0 = off (each scan forgets by gamma, whatever its rate). A scan of period dt
   /// (ScanView::period) then forgets by g = 1 - 2^(-dt / forget_half_life), so that lasers of any
   /// rate forget at the same rate per second. The exponent dt / forget_half_life of each scan is
-  /// rounded to a multiple of the map's forgetting unit (WaveletMap::forgetUnit(), 2^-11 with
-  /// the default pruning), and capped where a subtree becomes negligible.
+  /// rounded to a multiple of the map's forgetting unit (WaveletMap::forgetUnit(): 2^-11 with
+  /// the default pruning up to 0.8 s, finer beyond, so that a 25 ms scan counts 64 units or
+  /// more), at least one unit (a scan always forgets), and capped where a subtree becomes
+  /// negligible.
   double forget_half_life = 0.0;
   /// Lower clamp bound (log-odds), < 0; used by "clamp" and "clamp_lower".
   double clamp_min = -2.0;

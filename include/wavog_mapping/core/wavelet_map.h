@@ -133,6 +133,13 @@ class ReadoutTooLarge : public std::length_error {
   using std::length_error::length_error;
 };
 
+/// The payloads a map file holds besides the occupancy (WaveletMap::inspectFile): a map loading it
+/// without MapParams::reflection / MapParams::ndt drops them, and a later save writes it without.
+struct MapFileContents {
+  bool reflection = false;  ///< a reflection map (hits, or hit and miss layers)
+  bool ndt = false;         ///< normal-distribution cells
+};
+
 class WaveletMap {
  public:
   /// Throws std::invalid_argument naming every invalid parameter.
@@ -212,6 +219,9 @@ class WaveletMap {
   /// one with another resolution or block size, throws MapIoError naming the file and the reason,
   /// and leaves this map unchanged.
   void load(const std::string& path);
+  /// What the map file at `path` holds: read with the checks of load() (any resolution and
+  /// block_levels the parameters allow), so it throws MapIoError where load() would.
+  static MapFileContents inspectFile(const std::string& path);
 
   /// Counts; `count_observed` also walks the tree to count observed cells (O(nodes)).
   MapStats stats(bool count_observed = false) const;
@@ -224,6 +234,9 @@ class WaveletMap {
   /// A reflection layer (reflection.cpp): parameters made by the core, not validated.
   struct LayerTag {};
   WaveletMap(const MapParams& params, LayerTag);
+  /// load(), also saying what the file held (`contents` may be null; its ndt is read only by a
+  /// map with MapParams::ndt, as inspectFile's).
+  void load(const std::string& path, MapFileContents* contents);
   std::unique_ptr<Impl> impl_;
 };
 
