@@ -111,6 +111,7 @@ if(CATKIN_ENABLE_TESTING)
     wavog_rostest_gtest(test_hostile_input test/hostile_input.test test/ros/test_hostile_input.cpp)
     target_compile_definitions(test_hostile_input PRIVATE
       WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
+    target_link_libraries(test_hostile_input wavog_core)  # writes a map file with payloads
 
     # forget_half_life with inputs of two rates; the reflection layers' topics.
     wavog_rostest_gtest(test_half_life_rates test/half_life_rates.test

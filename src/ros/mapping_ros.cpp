@@ -29,6 +29,17 @@ Config loadReportingUnknown(const ros::NodeHandle& pnh) {
 
 }  // namespace
 
+void MappingRos::Impl::warnDroppedPayloads(const std::string& path) const {
+  const wavog::MapFileContents held = wavog::WaveletMap::inspectFile(path);
+  const auto warn = [&](const char* what, const char* key) {
+    ROS_WARN("%s: map_file '%s' holds %s, which this mapper drops (%s: false): a later save_map "
+             "writes the map without it; set %s: true to keep it",
+             pnh_.getNamespace().c_str(), path.c_str(), what, key, key);
+  };
+  if (held.reflection && !config_.map.reflection) warn("a reflection map", "reflection");
+  if (held.ndt && !config_.map.ndt) warn("normal-distribution (NDT) cells", "ndt");
+}
+
 MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
     : nh_(nh), pnh_(pnh), config_(loadReportingUnknown(pnh)), map_(config_.map) {
   const RosParams& rp = config_.ros;
@@ -41,6 +52,7 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
       throw std::runtime_error("map_file: cannot load '" + rp.map_file + "': " + e.what());
     }
     ROS_INFO("%s: loaded map_file '%s'", pnh_.getNamespace().c_str(), rp.map_file.c_str());
+    warnDroppedPayloads(rp.map_file);
   }
   subscribeTf();
 

@@ -72,6 +72,8 @@ struct MappingRos::Impl {
   ~Impl();
 
   // ---- construction (mapping_ros.cpp)
+  /// Warns about each payload of the map file at `path` this configuration does not keep.
+  void warnDroppedPayloads(const std::string& path) const;
   void subscribeTf();
   void addInput(const InputConfig& ic);
   void startReconfigure();

@@ -30,6 +30,7 @@
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"
 #include "wavog_mapping/SaveMap.h"
+#include "wavog_mapping/core/wavelet_map.h"
 
 namespace {
 
@@ -321,6 +322,41 @@ TEST(HostileStartUp, MapFileNotARegularFileFailsAtOnce) {
     EXPECT_LT((ros::WallTime::now() - t0).toSec(), 15.0);
   }
   ::unlink(fifo.c_str());
+}
+
+TEST(HostileStartUp, MapFileWithPayloadsTheNodeDropsIsWarnedAbout) {
+  // A map with a reflection map and NDT cells, loaded by a node configured without either.
+  const std::string pid = std::to_string(getpid());
+  const std::string file = "/tmp/wavog_hostile_payloads_" + pid + ".wavog";
+  {
+    wavog::MapParams p = wavog::MapParams::defaultsFor(wavog::PolicyType::kForget);
+    p.reflection = p.ndt = true;
+    wavog::WaveletMap map(p);
+    std::vector<float> ranges(90, 2.0f);
+    wavog::ScanView scan;
+    scan.ranges = ranges.data();
+    scan.count = ranges.size();
+    scan.angle_min = -0.8f;
+    scan.angle_increment = 0.02f;
+    scan.range_min = 0.1f;
+    scan.range_max = 10.0f;
+    map.integrate(wavog::Pose2{0.0, 0.0, 0.0}, scan);
+    map.save(file);
+  }
+  std::string output;
+  // The node keeps running after start-up: `timeout` ends it (exit 124) once it has said so.
+  const int code = room::run(std::string("timeout 6 ") + WAVOG_NODE_BIN + " __name:=payloads_" +
+                                 pid + " map:=/payloads_" + pid + "/map _map_file:=" + file,
+                             &output);
+  EXPECT_EQ(code, 124) << output;
+  EXPECT_NE(output.find("holds a reflection map, which this mapper drops (reflection: false)"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("holds normal-distribution (NDT) cells, which this mapper drops (ndt: "
+                        "false)"),
+            std::string::npos)
+      << output;
+  std::remove(file.c_str());
 }
 
 }  // namespace
