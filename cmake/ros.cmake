@@ -16,6 +16,7 @@ if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/mapping_ros.cpp)
     src/ros/conversions.cpp
     src/ros/scan_placement.cpp
     src/ros/input_status.cpp
+    src/ros/pose_check.cpp
     src/ros/map_publisher.cpp
     src/ros/reconfigure.cpp
     src/ros/mapping_ros.cpp
@@ -68,6 +69,15 @@ if(CATKIN_ENABLE_TESTING)
     catkin_add_gtest(test_seq_gaps test/ros/test_seq_gaps.cpp)
     if(TARGET test_seq_gaps)
       target_link_libraries(test_seq_gaps wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
+    # Absurd poses from tf (issue 27) and other people's scan geometry: no master needed.
+    catkin_add_gtest(test_pose_check test/ros/test_pose_check.cpp)
+    if(TARGET test_pose_check)
+      target_link_libraries(test_pose_check wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
+    catkin_add_gtest(test_scan_geometry test/ros/test_scan_geometry.cpp)
+    if(TARGET test_scan_geometry)
+      target_link_libraries(test_scan_geometry wavog_ros ${GTEST_MAIN_LIBRARIES})
     endif()
     # The NDT layers as MarkerArray and PointCloud2 (issue 14).
     catkin_add_gtest(test_ndt_conversions test/ros/test_ndt_conversions.cpp)

@@ -8,7 +8,10 @@
 #include <algorithm>
 #include <boost/make_shared.hpp>
 #include <cmath>
+#include <sstream>
 #include <vector>
+
+#include "wavog_mapping/core/limits.h"
 
 namespace wavog_ros {
 namespace {
@@ -30,8 +33,9 @@ bool clip(double clip_lo, double clip_hi, double* lo, double* hi) {
 const char* toString(DropReason reason) {
   // In DropReason order.
   static constexpr const char* kNames[kNumDropReasons] = {
-      "empty",      "size_mismatch", "bad_angles",   "bad_frame", "tf_unavailable",
-      "tf_too_old", "no_valid_beam", "bad_geometry", "bad_time",  "exception"};
+      "empty",         "bad_angles",   "bad_frame",     "tf_unavailable",
+      "tf_too_old",    "no_valid_beam", "bad_geometry", "out_of_extent",
+      "absurd_pose",   "bad_time",      "exception"};
   const auto i = static_cast<std::size_t>(reason);
   return i < kNumDropReasons ? kNames[i] : "unknown";
 }
@@ -54,8 +58,7 @@ bool checkScan(const sensor_msgs::LaserScan& scan, DropReason* reason) {
     return false;
   }
   const double inc = scan.angle_increment;
-  if (!std::isfinite(inc) || inc == 0.0 || !std::isfinite(scan.angle_min) ||
-      !std::isfinite(scan.angle_max)) {
+  if (!std::isfinite(inc) || inc == 0.0 || !std::isfinite(scan.angle_min)) {
     *reason = DropReason::kBadAngles;
     return false;
   }
@@ -63,13 +66,20 @@ bool checkScan(const sensor_msgs::LaserScan& scan, DropReason* reason) {
     *reason = DropReason::kEmpty;
     return false;
   }
-  // angle_max is the bearing of the last beam; drivers round it, so one beam of slack.
-  const double expected = (static_cast<double>(scan.angle_max) - scan.angle_min) / inc + 1.0;
-  if (std::abs(expected - static_cast<double>(scan.ranges.size())) > 1.01) {
-    *reason = DropReason::kSizeMismatch;
-    return false;
-  }
   return true;
+}
+
+double impliedBeams(const sensor_msgs::LaserScan& scan) {
+  return (static_cast<double>(scan.angle_max) - scan.angle_min) / scan.angle_increment + 1.0;
+}
+
+bool beamCountMismatch(const sensor_msgs::LaserScan& scan) {
+  // Negated: a NaN (angle_max not finite) is a mismatch too.
+  return !(std::abs(impliedBeams(scan) - static_cast<double>(scan.ranges.size())) <= 1.01);
+}
+
+bool intensitiesMismatch(const sensor_msgs::LaserScan& scan) {
+  return !scan.intensities.empty() && scan.intensities.size() != scan.ranges.size();
 }
 
 double secondsBetween(const ros::Time& a, const ros::Time& b) {
@@ -123,7 +133,37 @@ wavog::ScanView toScanView(const sensor_msgs::LaserScan& scan) {
   v.angle_increment = scan.angle_increment;
   v.range_min = scan.range_min;
   v.range_max = scan.range_max;
+  const double turn = 2.0 * M_PI;
+  const double fov = std::abs(v.angle_increment) * static_cast<double>(v.count);
+  if (fov > turn && fov <= turn * (1.0 + kFullTurnSlack)) {
+    v.angle_increment = std::copysign(turn / static_cast<double>(v.count), v.angle_increment);
+  }
   return v;
+}
+
+std::string geometryRefusal(const wavog::ScanView& v) {
+  // The checks of the core (prepared_scan.cpp, checkScan) in its order, with limits.h's values.
+  std::ostringstream s;
+  const double beams = static_cast<double>(v.count);
+  if (!(std::abs(v.angle_min) <= wavog::kMaxAbsAngleMin)) {
+    s << "|angle_min| " << v.angle_min << " rad beyond " << wavog::kMaxAbsAngleMin << " rad";
+  } else if (!std::isfinite(v.angle_increment) ||
+             !(std::abs(v.angle_increment) >= wavog::kMinAbsAngleIncrement)) {
+    s << "|angle_increment| " << v.angle_increment << " rad below "
+      << wavog::kMinAbsAngleIncrement << " rad";
+  } else if (!std::isfinite(v.range_min) || v.range_min < 0.0) {
+    s << "range_min " << v.range_min << " m is negative or not finite";
+  } else if (!(v.range_max > v.range_min)) {
+    s << "range_max " << v.range_max << " m is not above range_min " << v.range_min << " m";
+  } else if (v.count > wavog::kMaxBeams) {
+    s << v.count << " beams, more than " << wavog::kMaxBeams;
+  } else if (std::abs(v.angle_increment) * beams > 2.0 * M_PI + 1e-6) {
+    s << "field of view " << v.count << " beams x " << std::abs(v.angle_increment)
+      << " rad = " << std::abs(v.angle_increment) * beams << " rad beyond 2 pi";
+  } else {
+    s << "a geometry limit of the core (limits.h)";
+  }
+  return s.str();
 }
 
 wavog::Pose2 toPose2(const geometry_msgs::Transform& transform, bool* mirrored) {
@@ -142,6 +182,38 @@ wavog::Pose2 toPose2(const geometry_msgs::Transform& transform, bool* mirrored) 
 void mirrorView(wavog::ScanView* view) {
   view->angle_min = -view->angle_min;
   view->angle_increment = -view->angle_increment;
+}
+
+std::string coreRefusal(const wavog::IntegrateStats& st, const wavog::ScanView& view,
+                          const wavog::Pose2& pose, const wavog::MapParams& params) {
+  std::ostringstream s;
+  s << "refused by the core (" << wavog::toString(st.status) << "): ";
+  switch (st.status) {
+    case wavog::ScanStatus::kEmpty:
+      s << "no beams";
+      break;
+    case wavog::ScanStatus::kNoValidBeam:
+      s << "nothing to integrate: of " << view.count << " beams, " << st.beams_invalid
+        << " invalid (NaN, -inf, <= 0 or below range_min " << view.range_min << " m), "
+        << st.beams_no_return << " no return (+inf or >= range_max " << view.range_max
+        << " m), of which " << st.beams_beyond_limit << " beyond the hard range limit of "
+        << wavog::hardRangeLimit(params.grid, view.count) << " m (limits.h, for "
+        << view.count << " beams at resolution " << params.grid.resolution << " m)";
+      break;
+    case wavog::ScanStatus::kOutOfExtent:
+      s << "the laser at (" << pose.x << ", " << pose.y << ") m plus its reach leaves the "
+        << "representable extent of +-" << static_cast<double>(wavog::kCellIndexLimit) *
+                                                   params.grid.resolution
+        << " m (2^30 cells)";
+      break;
+    case wavog::ScanStatus::kBadPose:
+      s << "the laser's pose (" << pose.x << ", " << pose.y << ", " << pose.theta
+        << ") is not finite";
+      break;
+    default:
+      s << geometryRefusal(view);
+  }
+  return s.str();
 }
 
 LayerSize layerBox(const wavog::WaveletMap& map, int scale, double window, double cx, double cy,

@@ -26,10 +26,17 @@ enum class Counter : std::size_t {
   kTimeJumps = kDroppedFirst + kNumDropReasons,
   kMotionFallbacks,
   kIntegratedLatestTf,  ///< integrated with the latest tf when the input stopped (end of a bag)
+  kBeamCountMismatches,  ///< range count disagrees with the angles (integrated all the same)
+  kIntensitiesIgnored,   ///< intensities of another length than ranges
+  // The core's IntegrateStats, summed over the scans it was given.
+  kBeamsHit,
   kBeamsInvalid,
   kBeamsNoReturn,
+  kBeamsBeyondLimit,
+  kNodesVisited,
+  kBlocksTouched,
 };
-constexpr std::size_t kNumCounters = static_cast<std::size_t>(Counter::kBeamsNoReturn) + 1;
+constexpr std::size_t kNumCounters = static_cast<std::size_t>(Counter::kBlocksTouched) + 1;
 
 /// The counter of scans dropped for `reason`.
 constexpr Counter droppedCounter(DropReason reason) {

@@ -58,7 +58,9 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
 
   publisher_ = std::make_unique<MapPublisher>(nh_, rp.publish_scales, config_.map.reflection,
                                               config_.map.ndt);  // not yet shared: no lock
-  status_pub_ = pnh_.advertise<wavog_mapping::MapperStatus>("status", 10);
+  // Latched: the last status stays readable after a bag ends (its /clock, and so the publish
+  // timer, stops with it; the end of the input publishes it once more).
+  status_pub_ = pnh_.advertise<wavog_mapping::MapperStatus>("status", 10, true);
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, pnh_.getNamespace());
   updater_->setHardwareID("wavog_mapping");
   updater_->add("mapper",

@@ -1,6 +1,7 @@
 // The end of the input (a bag that ends, a robot whose drivers stop): scans still waiting in the
 // tf filters for a transform that will never come are integrated with the latest one (counted as
-// integrated_latest_tf), and the last partial publication period reaches the topics. Triggered by
+// integrated_latest_tf), and the last partial publication period reaches the topics (~status at
+// least, latched, so that it can be read after a bag's clock has stopped). Triggered by
 // the idle timer (idle_timeout of wall time without any scan or tf), by ~flush and by ~save_map.
 #include <ros/ros.h>
 #include <tf2/exceptions.h>
@@ -36,7 +37,10 @@ void MappingRos::Impl::onIdleTimer(const ros::WallTimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
     changed = changed_since_publish_;
   }
-  if (!changed) return;
+  if (!changed) {
+    publishStatus();  // the final counters (latched), after the last timer's publication
+    return;
+  }
   ROS_INFO(
       "%s: no scan or tf for %.1f s: %zu waiting scan(s) integrated with the latest tf, "
       "publishing the map",

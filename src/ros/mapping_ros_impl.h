@@ -26,6 +26,7 @@
 
 #include "input_status.h"
 #include "map_publisher.h"
+#include "pose_check.h"
 #include "reconfigure.h"
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"
@@ -44,6 +45,14 @@ using ScanFilter = tf2_ros::MessageFilter<sensor_msgs::LaserScan>;
 
 /// Seconds between two warnings of the same input and reason.
 constexpr double kWarnPeriod = 5.0;
+/// Warning slots of an input (Input::last_warn) after one per drop reason.
+enum WarningSlot : std::size_t {
+  kOtherWarning = kNumDropReasons,  ///< time jumps and motion fallbacks
+  kLostWarning,                     ///< scans lost before the node received them
+  kBeamCountWarning,                ///< range count disagreeing with the angles
+  kIntensitiesWarning,              ///< intensities of another length than ranges
+  kNumWarningSlots
+};
 
 /// One LaserScan input: its subscription, its tf filter and its counters.
 struct Input {
@@ -52,8 +61,8 @@ struct Input {
   ros::Subscriber sub;
   std::unique_ptr<ScanFilter> filter;
   InputCounters c;  ///< guarded by Impl::mutex_
-  /// Last warning per drop reason, then: time jumps and fallbacks (kOtherWarning), lost scans.
-  std::array<ros::WallTime, kNumDropReasons + 2> last_warn;
+  /// Last warning per drop reason, then per WarningSlot.
+  std::array<ros::WallTime, kNumWarningSlots> last_warn;
   double min_freq = 0.0;  ///< diagnostics bounds (the FrequencyStatus keeps pointers to them)
   double max_freq = 0.0;
   diagnostic_updater::FrequencyStatus* freq = nullptr;  ///< owned by Impl::freq_; may be null
@@ -61,6 +70,7 @@ struct Input {
   mutable std::uint64_t lost_reported = 0;
   bool slash_warned = false;  ///< the leading-'/' warning was given (guarded by Impl::mutex_)
   wavog::ScanPeriod period;   ///< of this laser's scans, for forget_half_life (Impl::mutex_)
+  PoseCheck poses;            ///< absurd poses from tf (Impl::mutex_)
   /// Scans handed to the tf filter and not yet out of it (integrated, dropped or flushed), oldest
   /// first; whoever removes a scan from here owns it. Guarded by Impl::mutex_. At most about
   /// queue_size long: the filter reports every scan it drops.
@@ -86,6 +96,9 @@ struct MappingRos::Impl {
   void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan, std::uintptr_t connection);
   /// Counts the scans missing before `scan` (header.seq gaps) and warns. Under mutex_.
   void countLostLocked(Input* in, const sensor_msgs::LaserScan& scan, std::uintptr_t connection);
+  /// Counts and warns about a checked scan that is integrated all the same: a range count that
+  /// disagrees with its angles, intensities of another length. Under mutex_.
+  void countOddGeometryLocked(Input* in, const sensor_msgs::LaserScan& scan);
   void onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static);
   void onFilterFailure(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
                        tf2_ros::filter_failure_reasons::FilterFailureReason reason);
@@ -126,6 +139,8 @@ struct MappingRos::Impl {
   void onPublishTimer(const ros::TimerEvent&);
   /// Reads and publishes every layer and ~status now (timer, end of input, services).
   void publishAll();
+  /// Publishes ~status alone (the end of the input when the map has not changed since).
+  void publishStatus();
   void onUpdateTimer(const ros::TimerEvent&);
   wavog_mapping::MapperStatus::Ptr statusLocked(const ros::Time& now);
 

@@ -64,6 +64,15 @@ void MappingRos::Impl::publishAll() {
   publish_time_ = elapsed;
 }
 
+void MappingRos::Impl::publishStatus() {
+  wavog_mapping::MapperStatus::Ptr status;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    status = statusLocked(ros::Time::now());
+  }
+  status_pub_.publish(status);
+}
+
 wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time& now) {
   auto status = boost::make_shared<wavog_mapping::MapperStatus>();
   const double period = secondsBetween(now, last_status_time_);  // a /clock may be anything

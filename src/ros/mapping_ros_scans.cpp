@@ -20,26 +20,19 @@ using Clock = std::chrono::steady_clock;
 
 /// Stamps (or the clock) going back by more than this (s) are a time jump (e.g. a bag restart).
 constexpr double kTimeJumpThreshold = 1.0;
-/// Warning slot (Input::last_warn) shared by time jumps and motion fallbacks.
-constexpr std::size_t kOtherWarning = kNumDropReasons;
-/// Warning slot (Input::last_warn) of scans lost before the node received them.
-constexpr std::size_t kLostWarning = kNumDropReasons + 1;
-
 /// Why the core refused a scan, as a drop reason.
 DropReason refusal(wavog::ScanStatus status) {
-  if (status == wavog::ScanStatus::kEmpty) return DropReason::kEmpty;
-  if (status == wavog::ScanStatus::kNoValidBeam) return DropReason::kNoValidBeam;
-  return DropReason::kBadGeometry;  // kBadGeometry, kBadPose
-}
-
-std::string refusalDetail(wavog::ScanStatus status) {
-  switch (refusal(status)) {
-    case DropReason::kEmpty:
-      return "no beams";
-    case DropReason::kNoValidBeam:
-      return "every beam is NaN, -inf or below range_min";
+  switch (status) {
+    case wavog::ScanStatus::kEmpty:
+      return DropReason::kEmpty;
+    case wavog::ScanStatus::kNoValidBeam:
+      return DropReason::kNoValidBeam;
+    case wavog::ScanStatus::kOutOfExtent:
+      return DropReason::kOutOfExtent;
+    case wavog::ScanStatus::kBadPose:
+      return DropReason::kAbsurdPose;
     default:
-      return std::string("refused by the core: ") + wavog::toString(status);
+      return DropReason::kBadGeometry;
   }
 }
 
@@ -87,7 +80,9 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
     }
     c.last_received_stamp = scan->header.stamp;
     DropReason reason{};
-    if (!checkScan(*scan, &reason)) {
+    const bool checked = checkScan(*scan, &reason);
+    if (checked) countOddGeometryLocked(in, *scan);
+    if (!checked) {
       std::ostringstream detail;
       detail << "frame_id '" << scan->header.frame_id << "', " << scan->ranges.size()
              << " ranges, angles [" << scan->angle_min << ", " << scan->angle_max << "] step "
@@ -130,6 +125,26 @@ void MappingRos::Impl::countLostLocked(Input* in, const sensor_msgs::LaserScan& 
                  "): the node is slower than this input. Raise subscriber_queue_size, play the "
                  "bag slower (rosbag play -r), or give the node more CPU (a less loaded host, "
                  "fewer publish_scales, a coarser resolution, num_threads)");
+}
+
+void MappingRos::Impl::countOddGeometryLocked(Input* in, const sensor_msgs::LaserScan& scan) {
+  if (beamCountMismatch(scan)) {
+    const std::uint64_t n = ++in->c[Counter::kBeamCountMismatches];
+    std::ostringstream text;
+    text << scan.ranges.size() << " ranges, but angle_min " << scan.angle_min << ", angle_max "
+         << scan.angle_max << " and angle_increment " << scan.angle_increment << " imply "
+         << impliedBeams(scan) << " beams (" << n
+         << " such scans so far): integrated as laser_geometry places them, beam i at angle_min "
+            "+ i * angle_increment (angle_max unused)";
+    warnLocked(in, kBeamCountWarning, text.str());
+  }
+  if (intensitiesMismatch(scan)) {
+    const std::uint64_t n = ++in->c[Counter::kIntensitiesIgnored];
+    warnLocked(in, kIntensitiesWarning,
+               std::to_string(scan.intensities.size()) + " intensities for " +
+                   std::to_string(scan.ranges.size()) + " ranges (" + std::to_string(n) +
+                   " such scans so far): intensities ignored, the scan is integrated");
+  }
 }
 
 void MappingRos::Impl::onTf(const tf2_msgs::TFMessage::ConstPtr& msg, bool is_static) {
@@ -208,6 +223,15 @@ bool MappingRos::Impl::takePendingLocked(Input* in, const sensor_msgs::LaserScan
 
 void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& scan,
                                        const ScanPlacement& placement) {
+  // tf can place a laser anywhere (corrupt odometry): refused before the core sees it.
+  const double first_beam = scan.header.stamp.toSec();
+  const double last_beam = first_beam + (placement.compensate ? sweepSeconds(scan) : 0.0);
+  const std::string absurd = in->poses.check(scan.header.frame_id, placement.start, first_beam,
+                                             placement.end, last_beam);
+  if (!absurd.empty()) {
+    dropLocked(in, DropReason::kAbsurdPose, absurd);
+    return;
+  }
   wavog::Pose2 pose;
   wavog::ScanView view = placement.placedView(scan, &compensator_, &pose);
   view.period = in->period.next(scan.header.stamp.toSec(), scan.scan_time);
@@ -218,10 +242,14 @@ void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& 
   integrate_time_max_ = std::max(integrate_time_max_, dt);
   ++integrate_count_;
   InputCounters& c = in->c;
+  c[Counter::kBeamsHit] += st.beams_hit;
   c[Counter::kBeamsInvalid] += st.beams_invalid;
   c[Counter::kBeamsNoReturn] += st.beams_no_return;
+  c[Counter::kBeamsBeyondLimit] += st.beams_beyond_limit;
+  c[Counter::kNodesVisited] += st.nodes_visited;
+  c[Counter::kBlocksTouched] += st.blocks_touched;
   if (st.status != wavog::ScanStatus::kOk) {
-    dropLocked(in, refusal(st.status), refusalDetail(st.status));
+    dropLocked(in, refusal(st.status), coreRefusal(st, view, pose, map_.params()));
     return;
   }
   ++c[Counter::kIntegrated];

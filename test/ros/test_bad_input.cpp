@@ -1,7 +1,10 @@
-// Bad inputs: every malformed scan of the issue (REP 117 values, size mismatch, bad angles, empty,
+// Bad inputs: every malformed scan of the issue (REP 117 values, bad angles, empty,
 // empty / unknown frame, stamp too old for tf, time jumping backwards, bad range limits)
 // is counted by reason; the node stays up and keeps integrating; the map is unchanged where the
-// dropped scans would have changed it. A tf1-style '/' frame id is stripped, and its scan used.
+// dropped scans would have changed it. A tf1-style '/' frame id is stripped, and its scan used; a
+// range count disagreeing with the angles, and intensities of another length, are integrated
+// (counted). Odometry jumping to an absurd pose for one tf sample and back: the scan there is
+// refused as absurd_pose, the map keeps its size, mapping goes on at the next sane pose.
 #include <gtest/gtest.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
@@ -12,6 +15,7 @@
 #include <limits>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 #include "room.h"
 #include "wavog_mapping/MapperStatus.h"
@@ -99,8 +103,12 @@ TEST(BadInput, EveryReasonCountedNodeStaysUpMapUnchanged) {
   empty->ranges.clear();
   g_scan_pub.publish(empty);
 
-  auto size_mismatch = phantom();
+  // Not bad (issue 27): a range count disagreeing with the angles (beam i at angle_min + i *
+  // angle_increment, angle_max unused, as laser_geometry does) and intensities of another length
+  // are integrated, each counted.
+  auto size_mismatch = room::scanOf(room::sensors()[0], ros::Time::now());
   size_mismatch->ranges.resize(100);
+  size_mismatch->intensities.assign(3, 1.0f);
   g_scan_pub.publish(size_mismatch);
 
   auto zero_inc = phantom();
@@ -161,14 +169,15 @@ TEST(BadInput, EveryReasonCountedNodeStaysUpMapUnchanged) {
 
   s = waitStatus(
       [&](const wavog_mapping::InputStatus& in) {
-        return in.integrated >= integrated_before + 8 && in.dropped_tf_unavailable >= 1 &&
+        return in.integrated >= integrated_before + 9 && in.dropped_tf_unavailable >= 1 &&
                in.dropped_tf_too_old >= 1;
       },
       20);
   ASSERT_TRUE(s);
   const auto& in = s->inputs[0];
   EXPECT_EQ(in.dropped_empty, 1u);
-  EXPECT_EQ(in.dropped_size_mismatch, 1u);
+  EXPECT_EQ(in.beam_count_mismatches, 1u);
+  EXPECT_EQ(in.intensities_ignored, 1u);
   EXPECT_EQ(in.dropped_bad_angles, 2u);
   EXPECT_EQ(in.dropped_bad_frame, 1u);  // the empty frame_id
   EXPECT_EQ(in.dropped_no_valid_beam, 1u);
@@ -178,7 +187,12 @@ TEST(BadInput, EveryReasonCountedNodeStaysUpMapUnchanged) {
   EXPECT_GE(in.time_jumps, 1u);
   EXPECT_GE(in.beams_invalid, 3u);
   EXPECT_GE(in.beams_no_return, 1u);
-  EXPECT_GE(in.integrated, integrated_before + 8);  // slashed, REP 117, jumped, 5 good ones
+  // the mismatched one, slashed, REP 117, jumped, 5 good ones
+  EXPECT_GE(in.integrated, integrated_before + 9);
+  EXPECT_EQ(in.dropped_absurd_pose + in.dropped_out_of_extent, 0u);
+  EXPECT_GT(in.beams_hit, 0u);
+  EXPECT_GT(in.nodes_visited, 0u);
+  EXPECT_GT(in.blocks_touched, 0u);
   EXPECT_EQ(s->tf_failures, in.dropped_tf_unavailable + in.dropped_tf_too_old);
 
   // The map after the next publication: the phantom wall never made it in.
@@ -191,6 +205,64 @@ TEST(BadInput, EveryReasonCountedNodeStaysUpMapUnchanged) {
   const int after_value = room::cellAt(*lastMap(), px, py);
   EXPECT_GE(after_value, 0);
   EXPECT_LT(after_value, 35) << "a dropped scan changed the map";
+  EXPECT_GT(room::cellAt(*lastMap(), room::kOccX, room::kOccY), 65);
+}
+
+TEST(BadInput, AbsurdPoseFromTfRefusedMapKeptMappingGoesOn) {
+  auto s = waitStatus([](const wavog_mapping::InputStatus& in) { return in.integrated >= 1; }, 20);
+  ASSERT_TRUE(s);
+  const wavog_mapping::InputStatus before = s->inputs[0];
+  const std::uint64_t layers_refused = s->layers_refused;
+  // jumpy_laser sits where laser_1 is, by tf samples every 0.1 s, but one sample (as the oko bag's
+  // odometry) puts it 2.76e7 m away: inside the extent at 5 cm, so the core would map it there.
+  const ros::Time t0 = ros::Time::now() - ros::Duration(2.0);
+  const tf2::Transform sane = room::sensorInBase(room::sensors()[0]);
+  std::vector<geometry_msgs::TransformStamped> samples;
+  for (int k = 0; k <= 20; ++k) {
+    tf2::Transform t = sane;
+    if (k == 10) t.setOrigin(tf2::Vector3(sane.getOrigin().x(), -2.76e7, 0.0));
+    samples.push_back(room::toMsg(t, "base_link", "jumpy_laser"));
+    samples.back().header.stamp = t0 + ros::Duration(0.1 * k);
+  }
+  tf2_ros::TransformBroadcaster tf;
+  tf.sendTransform(samples);
+  ros::WallDuration(0.3).sleep();
+  auto at = [&](double dt, bool wall) {
+    auto scan = wall ? room::scanOf(room::sensors()[0], t0 + ros::Duration(dt)) : phantom();
+    scan->header.frame_id = "jumpy_laser";
+    scan->header.stamp = t0 + ros::Duration(dt);
+    scan->time_increment = 0.0f;  // one pose per scan: the sample itself
+    return scan;
+  };
+  g_scan_pub.publish(at(0.3, true));  // sane: the reference
+  ros::WallDuration(0.2).sleep();
+  g_scan_pub.publish(at(1.0, false));  // the phantom wall at the absurd sample
+  ros::WallDuration(0.2).sleep();
+  g_scan_pub.publish(at(1.7, true));  // sane again: mapped
+  s = waitStatus(
+      [&](const wavog_mapping::InputStatus& in) {
+        return in.integrated >= before.integrated + 2 &&
+               in.dropped_absurd_pose > before.dropped_absurd_pose;
+      },
+      20);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->inputs[0].dropped_absurd_pose, before.dropped_absurd_pose + 1);
+  EXPECT_EQ(s->inputs[0].integrated, before.integrated + 2);
+  // The map keeps its size (one scan 2.76e7 m away would make every layer too large to publish)
+  // and the phantom wall is nowhere in it.
+  const ros::Time after = ros::Time::now();
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(10);
+  while (ros::WallTime::now() < end && !(lastMap() && lastMap()->header.stamp > after)) {
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_TRUE(lastMap());
+  s = waitStatus([](const wavog_mapping::InputStatus&) { return true; }, 1);
+  EXPECT_EQ(s->layers_refused, layers_refused);
+  EXPECT_LT(lastMap()->info.width, 1000u);
+  EXPECT_LT(lastMap()->info.height, 1000u);
+  double px = 0, py = 0;
+  phantomPoint(&px, &py);
+  EXPECT_LT(room::cellAt(*lastMap(), px, py), 35) << "the refused scan changed the map";
   EXPECT_GT(room::cellAt(*lastMap(), room::kOccX, room::kOccY), 65);
 }
 

@@ -220,12 +220,16 @@ TEST_F(Hostile, BeyondTheCoreLimitsCountedAndBounded) {
     auto scan = good();
     scan->range_max = kInf;
     scan->ranges[scan->ranges.size() / 2] = far;
+    const std::uint64_t beyond_limit = latestStatus()->inputs[0].beams_beyond_limit;
     sendNoReturnCase("a beam of " + std::to_string(far) + " m, range_max inf", scan);
+    EXPECT_EQ(latestStatus()->inputs[0].beams_beyond_limit, beyond_limit + 1);
   }
-  // A laser placed by tf 5e10 m away: outside the extent, refused by the core (bad_geometry).
+  // A laser placed by tf 5e10 m away: outside the extent, refused by the core and counted under
+  // the reason the log names (issue 28: once counted as bad_geometry).
   auto beyond = good();
   beyond->header.frame_id = "extent_plus";
-  sendCase("laser at 5e10 m", beyond, &InputStatus::dropped_bad_geometry);
+  sendCase("laser at 5e10 m", beyond, &InputStatus::dropped_out_of_extent);
+  EXPECT_EQ(latestStatus()->inputs[0].dropped_bad_geometry, 0u);
   // One scan of 1e6 beams in bounded time: the work budget (2^23 beam-cells) limits its range to
   // 8 cells, so its 3 m beams are no-returns and the scan has nothing to integrate (counted).
   auto many = good();
@@ -236,8 +240,11 @@ TEST_F(Hostile, BeyondTheCoreLimitsCountedAndBounded) {
   many->ranges.assign(1000000, 3.0f);
   many->intensities.clear();
   const std::uint64_t no_return = latestStatus()->inputs[0].beams_no_return;
+  const std::uint64_t beyond_limit = latestStatus()->inputs[0].beams_beyond_limit;
   sendCase("a scan of 1e6 beams", many, &InputStatus::dropped_no_valid_beam);
   EXPECT_GE(latestStatus()->inputs[0].beams_no_return, no_return + 1000000);
+  // Counted as beyond the hard range limit (issue 28: once nowhere in the status).
+  EXPECT_GE(latestStatus()->inputs[0].beams_beyond_limit, beyond_limit + 1000000);
   // clear_region of +-1e19 m clears the whole map (once: an undefined cast, nothing cleared).
   wavog_mapping::ClearRegion clear;
   clear.request.min_x = clear.request.min_y = -1e19;

@@ -27,10 +27,10 @@ ros::Publisher g_pub[3];
 
 /// Every drop counter of an input.
 std::uint64_t dropped(const wavog_mapping::InputStatus& in) {
-  return in.dropped_empty + in.dropped_size_mismatch + in.dropped_bad_angles +
+  return in.dropped_empty + in.dropped_bad_angles +
          in.dropped_bad_frame + in.dropped_tf_unavailable + in.dropped_tf_too_old +
-         in.dropped_no_valid_beam + in.dropped_bad_geometry + in.dropped_bad_time +
-         in.dropped_exception;
+         in.dropped_no_valid_beam + in.dropped_bad_geometry + in.dropped_out_of_extent +
+         in.dropped_absurd_pose + in.dropped_bad_time + in.dropped_exception;
 }
 
 /// Scans of the input accounted for: integrated, dropped for a reason, or lost before receipt.

@@ -147,10 +147,11 @@ TEST(MappingSystem, StatusCounters) {
     EXPECT_EQ(in.topic, "/scan_" + std::to_string(i + 1));
     EXPECT_GE(in.integrated, 5u);
     EXPECT_GE(in.received, in.integrated);
-    EXPECT_EQ(in.dropped_empty + in.dropped_size_mismatch + in.dropped_bad_angles +
-                  in.dropped_bad_frame + in.dropped_tf_too_old + in.dropped_no_valid_beam +
-                  in.dropped_bad_geometry,
+    EXPECT_EQ(in.dropped_empty + in.dropped_bad_angles + in.dropped_bad_frame +
+                  in.dropped_tf_too_old + in.dropped_no_valid_beam + in.dropped_bad_geometry +
+                  in.dropped_out_of_extent + in.dropped_absurd_pose,
               0u);
+    EXPECT_EQ(in.beam_count_mismatches, 0u);
     EXPECT_EQ(in.time_jumps, 0u);
     EXPECT_EQ(in.motion_fallbacks, 0u);
     EXPECT_GT(in.rate, 0.0);

@@ -22,17 +22,18 @@ namespace wavog_ros {
 /// Why a whole scan was dropped. Order = counter order in msg/InputStatus.msg.
 enum class DropReason {
   kEmpty,          ///< no beams
-  kSizeMismatch,   ///< ranges size disagrees with angle_min, angle_max, angle_increment
-  kBadAngles,      ///< angle_increment zero or non-finite, or non-finite angle limits
+  kBadAngles,      ///< angle_increment zero or non-finite, or angle_min non-finite
   kBadFrame,       ///< empty frame_id (a leading '/' is stripped first: stripFrameSlash)
   kTfUnavailable,  ///< unknown frame, or tf did not arrive before the queue overflowed
   kTfTooOld,       ///< stamp older than the tf buffer
-  kNoValidBeam,    ///< every beam invalid (REP 117): nothing to integrate
-  kBadGeometry,    ///< refused by the core (bad range limits, non-finite pose, ...)
+  kNoValidBeam,    ///< no beam to integrate: each invalid, or a no return (REP 117)
+  kBadGeometry,    ///< refused by the core: a limit of limits.h (angles, beams, range limits)
+  kOutOfExtent,    ///< refused by the core: pose plus reach outside the representable extent
+  kAbsurdPose,     ///< the laser's pose jumps faster than kMaxSensorSpeed, or is not finite
   kBadTime,        ///< stamp or time_increment outside what ROS time arithmetic can represent
   kException,      ///< an exception was caught while handling the scan (logged)
 };
-constexpr std::size_t kNumDropReasons = 10;
+constexpr std::size_t kNumDropReasons = 11;
 
 /// Longest sweep (s), |time_increment| x (beams - 1), of a scan that is accepted; a longer one, or
 /// a non-finite time_increment, is dropped as bad_time. Planar lasers sweep in 10-200 ms.
@@ -57,7 +58,7 @@ double sweepSeconds(const sensor_msgs::LaserScan& scan);
 /// most kMaxSweepSeconds. Returns false and sets *reason (kBadTime) otherwise. Never throws.
 bool checkScanTime(const sensor_msgs::LaserScan& scan, double tolerance, DropReason* reason);
 
-/// Short name of a drop reason ("empty", "size_mismatch", ...).
+/// Short name of a drop reason ("empty", "bad_angles", ...).
 const char* toString(DropReason reason);
 
 /// tf1-era drivers and bags write frame ids with a leading '/', which tf2 refuses: removes it.
@@ -66,13 +67,43 @@ bool stripFrameSlash(std::string* frame_id);
 /// The text of that one warning, for the frame as received (e.g. "/laser").
 std::string frameSlashWarning(const std::string& frame_id);
 
-/// Checks what tf cannot: frame id, angles, size against the angles, emptiness. Returns false and
+/// Checks what tf cannot: frame id, angle_min and angle_increment, emptiness. Returns false and
 /// sets *reason when the scan must be dropped. Beam values are not checked (REP 117: the core
-/// handles NaN and inf per beam).
+/// handles NaN and inf per beam), nor is angle_max: as laser_geometry (so costmap_2d),
+/// Cartographer and hector_mapping do, beam i lies at angle_min + i * angle_increment for every
+/// range of the message (beamCountMismatch() tells when angle_max disagrees).
 bool checkScan(const sensor_msgs::LaserScan& scan, DropReason* reason);
 
-/// Non-owning view of a checked scan (valid while the message lives).
+/// Beams that angle_min, angle_max and angle_increment imply: (max - min) / increment + 1 (NaN
+/// when they are not finite).
+double impliedBeams(const sensor_msgs::LaserScan& scan);
+/// Whether the range count disagrees with impliedBeams() by more than one beam (drivers round
+/// angle_max, or write the end of the last beam's sector: one beam of slack). Such a scan is
+/// integrated as the ecosystem places it (counted, warned).
+bool beamCountMismatch(const sensor_msgs::LaserScan& scan);
+/// Whether intensities are present with another length than ranges (ignored; the mapper does not
+/// read them: counted, warned).
+bool intensitiesMismatch(const sensor_msgs::LaserScan& scan);
+
+/// Relative excess over 2 pi of beams x |angle_increment| that is taken as a full turn whose
+/// increment the driver rounded up (e.g. 64 beams of 0.098175 rad: 2 pi + 1.4e-5): the increment
+/// becomes 2 pi / beams (moving the last beam by less than beams x 1e-4 x 2 pi / beams).
+constexpr double kFullTurnSlack = 1e-4;
+
+/// Non-owning view of a checked scan (valid while the message lives). A full turn whose increment
+/// is rounded up within kFullTurnSlack is spread over exactly 2 pi (the core refuses a field of
+/// view beyond 2 pi).
 wavog::ScanView toScanView(const sensor_msgs::LaserScan& scan);
+
+/// Why the core refused a view as ScanStatus::kBadGeometry: the limit (limits.h) it broke and the
+/// value, e.g. "range_max 10 is not above range_min 50".
+std::string geometryRefusal(const wavog::ScanView& view);
+
+/// What the log says of a scan the core refused (st.status != kOk): the status and the numbers
+/// behind it: for kNoValidBeam the beams invalid, no return and beyond the hard range limit (with
+/// that limit), for kOutOfExtent the pose and the extent, for kBadGeometry geometryRefusal().
+std::string coreRefusal(const wavog::IntegrateStats& st, const wavog::ScanView& view,
+                        const wavog::Pose2& pose, const wavog::MapParams& params);
 
 /// Planar pose (map frame) of a sensor from its 3D transform map <- sensor. A sensor mounted upside
 /// down (its z axis pointing down) sees the plane mirrored: *mirrored is set and the scan's view
