@@ -428,10 +428,12 @@ struct BlockBytes {
   }
 };
 
-// What a map can hold and a file must not claim otherwise (fuzz finding of issue 28): a node's
-// knowledge is the one its parent (or block) records for its slot. A file breaking it loaded and
-// read differently by each path: the max read-out found no observed cell under a slot marked
-// observed (-inf at scale 1). Such files are refused.
+// What a map can hold and a file must not claim otherwise (fuzz findings of issue 28): a slot
+// without a node of its own (a finest cell, a uniform child, a block without a root) is observed
+// entirely or not at all, and a node's knowledge is the one its parent (or block) records for its
+// slot. A file breaking either loaded and read differently by each path: the max read-out found
+// no observed cell under a slot marked observed (-inf at scale 1), and value() read the prior for
+// a finest cell the read-out showed observed (-1.66). Such files are refused.
 TEST(MapIo, KnowledgeTheMapCannotHoldIsRefused) {
   MapParams p = MapParams::defaultsFor(wavog::PolicyType::kClamp);
   p.grid.resolution = 0.25;
@@ -486,6 +488,16 @@ TEST(MapIo, KnowledgeTheMapCannotHoldIsRefused) {
   // The block records no knowledge, its root a fully observed subtree.
   cases.push_back({"root observed in an unobserved block", {}, "disagrees"});
   cases.back().file.block(0, 0, -0.1, 4).node(0.2f, -0.2f, 0.4f, 0, 0xF, 0xF);
+  // The finding fuzz_map_load_value_vs_readout: a finest cell marked partly observed (known_any
+  // without known_all; value() read the prior, the read-out -1.66).
+  cases.push_back({"finest cell partly observed", {}, "partly observed"});
+  cases.back().file.block(0, 0, -0.1, 6).node(0.2f, -0.2f, 0.4f, 1, 0, 1).node(0.4f, 0.4f, -0.8f,
+                                                                                0, 0, 1);
+  // A uniform 2 x 2 child partly observed, and a block without a root partly observed.
+  cases.push_back({"uniform child partly observed", {}, "partly observed"});
+  cases.back().file.block(0, 0, -0.1, 6).node(0.2f, -0.2f, 0.4f, 0, 0, 1);
+  cases.push_back({"uniform block partly observed", {}, "partly observed"});
+  cases.back().file.block(0, 0, -1.5, 2);
   for (const Case& c : cases) {
     SCOPED_TRACE(c.what);
     writeAll(path, fileWithBlocks(p, 1, c.file.bytes));

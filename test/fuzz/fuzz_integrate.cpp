@@ -3,10 +3,10 @@
 // read-out at every scale, stats, save and load.
 // Every MapParams option is switched from the bytes (reflection, ndt and its weights,
 // forget_half_life across its valid range, num_threads 2), and each scan has its own period.
-// Oracles besides the modes': every value read is finite, the payload read-outs agree with their
-// point queries, a serial twin (num_threads 1) saves a byte-identical file and reads the same,
-// whatever was saved loads and reads back equal (payloads included), and a loaded map stays
-// finite after one more scan.
+// Oracles besides the modes': every value read is finite, value() / isObserved() and the payload
+// read-outs agree with their scale-0 read-outs, a serial twin (num_threads 1) saves a
+// byte-identical file and reads the same, whatever was saved loads and reads back equal (payloads
+// included), and a loaded map stays finite after one more scan.
 // Two modes, chosen by the first decoded bit:
 //  - oracle: a small map (poses within 1 m, range limits up to 3 m, tau = 0) integrated next to
 //    the dense cell-by-cell reference (test/core/dense_reference.h); every cell, every coarse

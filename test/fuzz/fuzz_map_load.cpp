@@ -10,8 +10,9 @@
 // forget_half_life (16-bit pending units). Bit 5: the loading
 // map keeps normal-distribution cells (MapParams::ndt). Bit 7: it keeps a reflection map
 // (MapParams::reflection).
-// Oracles: a refused load leaves the map empty; a loaded map reads finite values, its payload
-// read-outs agree with their point queries, it saves and loads again reading the same (payloads
+// Oracles: a refused load leaves the map empty; a loaded map reads finite values, value() and
+// isObserved() agree with the scale-0 read-out, its payload read-outs agree with their point
+// queries, it saves and loads again reading the same (payloads
 // included), and it takes one ordinary scan staying finite (issue 28: a file with a block average
 // of -1e57 loaded and turned NaN).
 #include <zlib.h>

@@ -99,6 +99,40 @@ inline bool sameBits(const wavog::Raster& a, const wavog::Raster& b) {
          std::memcmp(a.log_odds.data(), b.log_odds.data(), a.log_odds.size() * sizeof(float)) == 0;
 }
 
+/// Cells of a scale-0 window whose point queries (value, reflection, ndtCell) a harness compares
+/// with the window's read-out: at most this many, from its lower corner (a speed choice).
+constexpr std::int64_t kPointQueries = 4096;
+
+/// The lower-corner window of at most kPointQueries cells of a scale-0 window `box`.
+inline wavog::CellBox pointQueryWindow(const wavog::CellBox& box) {
+  wavog::CellBox q = box;
+  q.max_x = q.min_x + std::min<std::int64_t>(q.width(), 64);
+  q.max_y = q.min_y + std::min<std::int64_t>(q.height(), kPointQueries / (q.max_x - q.min_x));
+  return q;
+}
+
+/// value() and isObserved() of each cell of the point-query window of the scale-0 window `box`
+/// agree with its scale-0 read-out (mean): observed exactly where the read-out knows the cell,
+/// reading its value (both from the same Haar averages, up to round-off), else the prior (issue
+/// 28: a loaded file's cell read 0 by value() and -1.66 by the read-out).
+inline void checkPointQueries(const wavog::WaveletMap& map, const wavog::CellBox& box) {
+  const wavog::CellBox q = pointQueryWindow(box);
+  const wavog::Raster r = map.exportScale(0, q, wavog::Aggregation::kMean);
+  for (std::int64_t y = q.min_y, i = 0; y < q.max_y; ++y) {
+    for (std::int64_t x = q.min_x; x < q.max_x; ++x, ++i) {
+      const auto at = static_cast<std::size_t>(i);
+      const bool known = r.known[at] != 0;
+      const float a = map.value({x, y}), b = r.log_odds[at];
+      WAVOG_FUZZ_CHECK(map.isObserved({x, y}) == known && std::isfinite(a) &&
+                           std::fabs(a - b) <= 1e-6f * std::max(1.0f, std::fabs(b)),
+                       "value(%lld, %lld) = %.9g observed %d, read-out %.9g known %d",
+                       static_cast<long long>(x), static_cast<long long>(y),
+                       static_cast<double>(a), map.isObserved({x, y}) ? 1 : 0,
+                       static_cast<double>(b), known ? 1 : 0);
+    }
+  }
+}
+
 /// Every scale over the map's bounds, both aggregations (a window the core must refuse is checked
 /// to be refused); each raster's size and its occupancy grid checked. Returns the rasters.
 inline std::vector<wavog::Raster> readOutEveryScale(const wavog::WaveletMap& map) {
@@ -111,6 +145,7 @@ inline std::vector<wavog::Raster> readOutEveryScale(const wavog::WaveletMap& map
       continue;
     }
     box = readOutWindow(box);
+    if (s == 0) checkPointQueries(map, box);
     for (wavog::Aggregation agg : {wavog::Aggregation::kMean, wavog::Aggregation::kMax}) {
       wavog::Raster r = map.exportScale(s, box, agg);
       const auto cells =
@@ -163,10 +198,6 @@ inline std::vector<wavog::Raster> readOutEveryScale(const wavog::WaveletMap& map
   return out;
 }
 
-/// Cells of a scale-0 window whose point queries (value, reflection, ndtCell) a harness compares
-/// with the window's read-out: at most this many, from its lower corner (a speed choice).
-constexpr std::int64_t kPointQueries = 4096;
-
 /// The payload read-outs of every scale over the map's bounds (the reflection probabilities and
 /// the Gaussians, flattened to floats / doubles), in a fixed order, for bit comparisons between
 /// two maps; at scale 0 each agrees with its point query (reflection(), ndtCell()).
@@ -188,10 +219,7 @@ inline Payloads readPayloads(const wavog::WaveletMap& map) {
     wavog::CellBox box;
     if (!map.bounds(s, &box) || !wavog::readoutFits(box)) break;
     box = readOutWindow(box);
-    // A lower-corner window of at most kPointQueries cells for the point queries (scale 0).
-    wavog::CellBox q = box;
-    q.max_x = q.min_x + std::min<std::int64_t>(q.width(), 64);
-    q.max_y = q.min_y + std::min<std::int64_t>(q.height(), kPointQueries / (q.max_x - q.min_x));
+    const wavog::CellBox q = pointQueryWindow(box);  // for the point queries (scale 0)
     if (refl) {
       const wavog::ReflectionRaster r = map.exportReflection(s, box);
       out.reflection.insert(out.reflection.end(), r.p.begin(), r.p.end());
