@@ -8,9 +8,30 @@ FUZZ_SECONDS ?= 60
 FUZZ_CXX ?= $$(command -v clang++-14 || command -v clang++)
 FUZZ_CC ?= $$(command -v clang-14 || command -v clang)
 
-.PHONY: fuzz
+# make fuzz-long: a campaign of FUZZ_LONG_SECONDS per harness (default 3 h) on the same tree,
+# resuming from build-fuzz/corpus/<harness>/ (what earlier runs found) and the stored seeds; ends
+# with executions and coverage per harness. FUZZ_JOBS=N runs N harnesses at once.
+FUZZ_LONG_SECONDS ?= 10800
+FUZZ_JOBS ?= 1
+
+.PHONY: fuzz fuzz-build fuzz-long
 ## libFuzzer harnesses (map loader, CARMEN reader, scan integration, node message path), FUZZ_SECONDS each.
-fuzz:
+fuzz: fuzz-build
+	@bash $(ROOT)/scripts/run_fuzz.sh $(BUILD_FUZZ) $(FUZZ_SECONDS)
+
+## A fuzz campaign of FUZZ_LONG_SECONDS per harness (default 3 h), resuming from earlier corpora.
+fuzz-long: fuzz-build
+	@if [ "$(FUZZ_JOBS)" -le 1 ]; then \
+	  bash $(ROOT)/scripts/run_fuzz.sh $(BUILD_FUZZ) $(FUZZ_LONG_SECONDS); \
+	else \
+	  for h in fuzz_map_load fuzz_carmen fuzz_integrate fuzz_node; do \
+	    bash $(ROOT)/scripts/run_fuzz.sh $(BUILD_FUZZ) $(FUZZ_LONG_SECONDS) $$h >$(BUILD_FUZZ)/long_$$h.txt & \
+	    while [ $$(jobs -r | wc -l) -ge $(FUZZ_JOBS) ]; do sleep 5; done; \
+	  done; wait; cat $(BUILD_FUZZ)/long_*.txt; \
+	  ! grep -q FAILED $(BUILD_FUZZ)/long_*.txt; \
+	fi
+
+fuzz-build:
 	@bash $(ROOT)/scripts/install_deps.sh fuzz
 	@mkdir -p $(BUILD_FUZZ)
 	@cmake -S $(ROOT) -B $(BUILD_FUZZ) -DCMAKE_CXX_COMPILER=$(FUZZ_CXX) -DCMAKE_C_COMPILER=$(FUZZ_CC) \
@@ -18,4 +39,3 @@ fuzz:
 	  -DWAVOG_SANITIZE="address;undefined;float-cast-overflow;fuzzer-no-link" \
 	  >$(BUILD_FUZZ)/configure.log || { cat $(BUILD_FUZZ)/configure.log; exit 1; }
 	@bash $(ROOT)/scripts/build.sh $(BUILD_FUZZ) $(JOBS) fuzzers
-	@bash $(ROOT)/scripts/run_fuzz.sh $(BUILD_FUZZ) $(FUZZ_SECONDS)

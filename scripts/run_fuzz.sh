@@ -2,7 +2,9 @@
 # Runs each libFuzzer harness of a fuzz build tree for SECONDS: scripts/run_fuzz.sh BUILD SECONDS
 # [HARNESS...]. Seeds come from test/fuzz/corpus/<harness>/ (read only); what the run finds goes
 # to BUILD/corpus/<harness>/ (kept between runs), a crashing input to BUILD/artifacts/<harness>/.
-# Prints executions, seconds and exec/s per harness; exit status non-zero if any harness failed.
+# Each run resumes from BUILD/corpus/<harness>/, so a campaign of hours can be run in parts
+# (make fuzz-long). Prints executions, seconds, exec/s, coverage (edges, features) and corpus
+# size per harness; exit status non-zero if any harness failed.
 set -uo pipefail
 build=${1:?usage: run_fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
 seconds=${2:?usage: run_fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
@@ -31,13 +33,19 @@ for h in "${harnesses[@]}"; do
   execs=$(grep -Eo 'stat::number_of_executed_units: *[0-9]+' "$log" | grep -Eo '[0-9]+$' | tail -1)
   rate=$(grep -Eo 'stat::average_exec_per_sec: *[0-9]+' "$log" | grep -Eo '[0-9]+$' | tail -1)
   secs=$(grep -Eo 'Done [0-9]+ runs in [0-9]+ second' "$log" | grep -Eo '[0-9]+ second' | grep -Eo '[0-9]+' | tail -1)
+  # Coverage of the last status line: edges (cov), features (ft), corpus entries (corp).
+  last=$(grep -E '^#[0-9]+' "$log" | grep -E 'cov: ' | tail -1)
+  cov=$(grep -Eo 'cov: [0-9]+' <<<"$last" | grep -Eo '[0-9]+')
+  ft=$(grep -Eo 'ft: [0-9]+' <<<"$last" | grep -Eo '[0-9]+')
+  corp=$(grep -Eo 'corp: [0-9]+' <<<"$last" | grep -Eo '[0-9]+')
   if [ "$status" -ne 0 ]; then
     failed=1
     echo "fuzz: $h FAILED (status $status); log $log, input in $artifacts:" >&2
     grep -E 'ERROR|runtime error|oracle failed|SUMMARY|Test unit written' "$log" | head -20 >&2
   fi
-  summary+=("$(printf '%-16s %s  %12s executions  %5s s  %8s exec/s' "$h" \
-    "$([ "$status" -eq 0 ] && echo clean || echo FAILED)" "${execs:-?}" "${secs:-?}" "${rate:-?}")")
+  summary+=("$(printf '%-16s %s  %12s executions  %6s s  %8s exec/s  cov %6s  ft %7s  corpus %6s' \
+    "$h" "$([ "$status" -eq 0 ] && echo clean || echo FAILED)" "${execs:-?}" "${secs:-?}" \
+    "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}")")
 done
 printf '%s\n' "${summary[@]}"
 exit "$failed"

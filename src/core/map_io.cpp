@@ -99,12 +99,27 @@ struct PendingFormat {
   bool same_unit;  // file_a is the map's unit factor: counts are kept as they are
 };
 
-// Reads a subtree into `impl` (a fresh map). Throws std::runtime_error on inconsistent data.
+// The knowledge a map can hold (map_slot.h, refineSlot): a node's is the one its slot records
+// (known_all: all four children known entirely; known_any: some), and a slot without a node of
+// its own (a finest cell, a uniform child, a block without a root) is observed entirely or not at
+// all. A file claiming otherwise would read differently by each path (value() by known_all, the
+// read-outs by known_any, the max read-out finding no observed cell under an observed slot).
+void checkSlotKnowledge(bool slot_all, bool slot_any, unsigned known_all, unsigned known_any) {
+  if (slot_all != (known_all == 0xFu) || slot_any != (known_any != 0)) {
+    throw std::runtime_error("a node's knowledge disagrees with its parent's");
+  }
+}
+void checkUniformKnowledge(bool all, bool any) {
+  if (all != any) throw std::runtime_error("a uniform slot partly observed");
+}
+
+// Reads a subtree into `impl` (a fresh map); `slot_all` / `slot_any`: the knowledge its slot
+// records. Throws std::runtime_error on inconsistent data.
 // A node's pending count is kept when it means the same for the map (and fits its counts);
 // otherwise it is applied now with the file's factor, together with `pending`, the ancestors'
 // counts applied the same way.
 void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, std::int64_t pending,
-              Reader* r) {
+              bool slot_all, bool slot_any, Reader* r) {
   for (float& d : n.d) {
     d = r->get<float>();
     if (!std::isfinite(d)) throw std::runtime_error("non-finite detail");
@@ -128,10 +143,15 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
   n.known_all = known_all & 0xFu;
   n.known_any = known_any & 0xFu;
   if (l == 1 && mask != 0) throw std::runtime_error("children below level 1");
+  checkSlotKnowledge(slot_all, slot_any, known_all, known_any);
   for (int q = 0; q < 4; ++q) {
-    if (!((mask >> q) & 1u)) continue;
+    const bool all = (known_all >> q) & 1u, any = (known_any >> q) & 1u;
+    if (!((mask >> q) & 1u)) {
+      checkUniformKnowledge(all, any);
+      continue;
+    }
     Node& c = impl.installChild(n, q, Node{});
-    readNode(impl, c, l - 1, f, pending, r);
+    readNode(impl, c, l - 1, f, pending, all, any, r);
   }
 }
 
@@ -227,7 +247,9 @@ void readBlocks(WaveletMap::Impl& fresh, const PendingFormat& format, std::size_
     b.has_root = (flags & 4) != 0;
     if (b.has_root) {
       ++fresh.nodes;
-      readNode(fresh, b.root, fresh.levels, format, 0, r);
+      readNode(fresh, b.root, fresh.levels, format, 0, b.known_all, b.known_any, r);
+    } else {
+      checkUniformKnowledge(b.known_all, b.known_any);
     }
   }
 }

@@ -72,7 +72,7 @@ void WaveletMap::Impl::configure() {
       k_star = 1;
     } else if (a < 1.0) {
       const double k = std::ceil(std::log(prune_threshold / (2.0 * range)) / std::log(a));
-      if (k < 255.0) k_star = std::max(1, static_cast<int>(k));
+      if (k < 255.0) k_star = static_cast<std::uint64_t>(std::max(1, static_cast<int>(k)));
     }
   }
 }

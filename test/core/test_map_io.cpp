@@ -387,5 +387,130 @@ TEST(MapIo, InspectFileSaysWhichPayloadsAFileHolds) {
   std::remove(path.c_str());
 }
 
+
+// Hand-built files: the header and the payload sections of an empty map saved under `p`, with
+// the blocks `blocks` (the version-5 encoding, block count `count`) in place of none.
+std::vector<char> fileWithBlocks(const MapParams& p, std::uint64_t count,
+                                 const std::vector<char>& blocks) {
+  const std::string path = tempPath("empty.wavog");
+  WaveletMap(p).save(path);
+  const auto empty = readAll(path);
+  std::remove(path.c_str());
+  constexpr std::size_t kCountAt = 8 + 4 + 8 + 4 + 8 + 8;  // u64 block count in the header
+  std::vector<char> out(empty.begin(), empty.begin() + kCountAt);
+  const auto* c = reinterpret_cast<const char*>(&count);
+  out.insert(out.end(), c, c + sizeof(count));
+  out.insert(out.end(), blocks.begin(), blocks.end());
+  out.insert(out.end(), empty.begin() + kCountAt + 8, empty.end() - 4);
+  const auto crc = static_cast<std::uint32_t>(
+      ::crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
+  const auto* k = reinterpret_cast<const char*>(&crc);
+  out.insert(out.end(), k, k + 4);
+  return out;
+}
+
+struct BlockBytes {
+  std::vector<char> bytes;
+  template <typename T>
+  BlockBytes& put(T v) {
+    const auto* b = reinterpret_cast<const char*>(&v);
+    bytes.insert(bytes.end(), b, b + sizeof(v));
+    return *this;
+  }
+  // Block (bx, by), average s, flags (1 known_all, 2 known_any, 4 has_root).
+  BlockBytes& block(std::int32_t bx, std::int32_t by, double s, std::uint8_t flags) {
+    return put(bx).put(by).put(s).put(flags);
+  }
+  // A node: details, no pending count, child mask and knowledge bits.
+  BlockBytes& node(float dx, float dy, float dxy, std::uint8_t mask, std::uint8_t all,
+                   std::uint8_t any) {
+    return put(dx).put(dy).put(dxy).put(std::uint16_t{0}).put(mask).put(all).put(any);
+  }
+};
+
+// What a map can hold and a file must not claim otherwise (fuzz findings of issue 28): a slot
+// without a node of its own (a finest cell, a uniform child, a block without a root) is observed
+// entirely or not at all, and a node's knowledge is the one its parent (or block) records for its
+// slot. A file breaking either loaded and read differently by each path: the max read-out found
+// no observed cell under a slot marked observed (-inf at scale 1), and value() read the prior for
+// a finest cell the read-out showed observed (-1.66). Such files are refused.
+TEST(MapIo, KnowledgeTheMapCannotHoldIsRefused) {
+  MapParams p = MapParams::defaultsFor(wavog::PolicyType::kClamp);
+  p.grid.resolution = 0.25;
+  p.grid.block_levels = 2;
+  const std::string path = tempPath("knowledge.wavog");
+  const wavog::CellBox cells{0, 0, 4, 4};
+  // value() / isObserved() of each finest cell, against the scale-0 read-out; every value of
+  // the max read-out at every scale finite.
+  const auto readsAgree = [&](const WaveletMap& map) {
+    const wavog::Raster r = map.exportScale(0, cells, wavog::Aggregation::kMean);
+    for (std::int64_t y = 0; y < 4; ++y) {
+      for (std::int64_t x = 0; x < 4; ++x) {
+        const auto i = static_cast<std::size_t>(y * 4 + x);
+        if (map.isObserved({x, y}) != (r.known[i] != 0)) return false;
+        if (r.known[i] && map.value({x, y}) != r.log_odds[i]) return false;
+      }
+    }
+    for (int s = 0; s <= 2; ++s) {
+      const wavog::CellBox box{0, 0, std::int64_t{4} >> s, std::int64_t{4} >> s};
+      for (float v : map.exportScale(s, box, wavog::Aggregation::kMax).log_odds) {
+        if (!std::isfinite(v)) return false;
+      }
+    }
+    return true;
+  };
+  // A file consistent in every bit loads, and each path reads it alike: cell 0 observed.
+  BlockBytes good;
+  good.block(0, 0, -0.1, 6).node(0.2f, -0.2f, 0.4f, 1, 0, 1).node(0.4f, 0.4f, -0.8f, 0, 1, 1);
+  writeAll(path, fileWithBlocks(p, 1, good.bytes));
+  {
+    WaveletMap map(p);
+    ASSERT_NO_THROW(map.load(path));
+    EXPECT_TRUE(map.isObserved({0, 0}));
+    EXPECT_FALSE(map.isObserved({1, 0}));
+    EXPECT_TRUE(readsAgree(map));
+  }
+  struct Case {
+    const char* what;
+    BlockBytes file;
+    const char* reason;
+  };
+  std::vector<Case> cases;
+  // The finding fuzz_map_load_scale1_minus_inf: the root marks child 0 observed, the child holds
+  // no observed cell (the max read-out at scale 1 read -inf).
+  cases.push_back({"child unobserved under an observed slot", {}, "disagrees"});
+  cases.back().file.block(0, 0, -0.1, 6).node(0.2f, -0.2f, 0.4f, 1, 0, 1).node(0.4f, 0.4f, -0.8f,
+                                                                                0, 0, 0);
+  // The child holds an observed cell, the root marks its slot unobserved.
+  cases.push_back({"child observed under an unobserved slot", {}, "disagrees"});
+  cases.back().file.block(0, 0, -0.1, 6).node(0.2f, -0.2f, 0.4f, 1, 2, 2).node(0.4f, 0.4f, -0.8f,
+                                                                                0, 1, 1);
+  // The block records no knowledge, its root a fully observed subtree.
+  cases.push_back({"root observed in an unobserved block", {}, "disagrees"});
+  cases.back().file.block(0, 0, -0.1, 4).node(0.2f, -0.2f, 0.4f, 0, 0xF, 0xF);
+  // The finding fuzz_map_load_value_vs_readout: a finest cell marked partly observed (known_any
+  // without known_all; value() read the prior, the read-out -1.66).
+  cases.push_back({"finest cell partly observed", {}, "partly observed"});
+  cases.back().file.block(0, 0, -0.1, 6).node(0.2f, -0.2f, 0.4f, 1, 0, 1).node(0.4f, 0.4f, -0.8f,
+                                                                                0, 0, 1);
+  // A uniform 2 x 2 child partly observed, and a block without a root partly observed.
+  cases.push_back({"uniform child partly observed", {}, "partly observed"});
+  cases.back().file.block(0, 0, -0.1, 6).node(0.2f, -0.2f, 0.4f, 0, 0, 1);
+  cases.push_back({"uniform block partly observed", {}, "partly observed"});
+  cases.back().file.block(0, 0, -1.5, 2);
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    writeAll(path, fileWithBlocks(p, 1, c.file.bytes));
+    WaveletMap map(p);
+    const std::string why = refusal(&map, path);
+    EXPECT_NE(why.find(c.reason), std::string::npos) << why;
+    EXPECT_EQ(map.stats().blocks, 0u);
+    if (why.empty()) {  // before the fix: loaded, and read differently by each path
+      EXPECT_TRUE(readsAgree(map));
+    }
+  }
+  std::remove(path.c_str());
+}
+
 }  // namespace
 }  // namespace wavog_test

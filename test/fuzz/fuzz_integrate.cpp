@@ -1,6 +1,12 @@
 // libFuzzer harness: scan integration with map parameters, poses, beam geometry, ranges and
 // clearBox bounds decoded from the bytes (NaN, +-inf, -0, denormals, 1e300, FLT_MAX, ...), then a
 // read-out at every scale, stats, save and load.
+// Every MapParams option is switched from the bytes (reflection, ndt and its weights,
+// forget_half_life across its valid range, num_threads 2), and each scan has its own period.
+// Oracles besides the modes': every value read is finite, value() / isObserved() and the payload
+// read-outs agree with their scale-0 read-outs, a serial twin (num_threads 1) saves a
+// byte-identical file and reads the same, whatever was saved loads and reads back equal (payloads
+// included), and a loaded map stays finite after one more scan.
 // Two modes, chosen by the first decoded bit:
 //  - oracle: a small map (poses within 1 m, range limits up to 3 m, tau = 0) integrated next to
 //    the dense cell-by-cell reference (test/core/dense_reference.h); every cell, every coarse
@@ -66,6 +72,23 @@ MapParams decodeParams(FuzzedDataProvider* in, bool oracle) {
   p.lazy_forgetting = in->ConsumeBool();
   p.reflection = in->ConsumeBool();
   p.ndt = in->ConsumeBool();
+  p.num_threads = in->ConsumeBool() ? 2 : 1;
+  if (p.ndt) {
+    p.ndt_min_weight = pick(in, {0.01, 0.0, 1e-9, 0.5, 2.0, 1e6});
+    p.ndt_max_weight = pick(in, {100.0, 1.0, 1.5, 3.0, 1e9});
+  }
+  // forget_half_life: off, or anywhere in (0, 1e6] s, log-uniform, with the ends exactly.
+  switch (in->ConsumeIntegralInRange<int>(0, 4)) {
+    case 0:
+      p.policy.forget_half_life = 0.0;
+      break;
+    case 1:
+      p.policy.forget_half_life = pick(in, {1e6, 1e-9, 409.7, 1000.0, 0.8, 0.81});
+      break;
+    default:
+      p.policy.forget_half_life = std::pow(10.0, in->ConsumeFloatingPointInRange<double>(-4.0, 6.0));
+      break;
+  }
   if (oracle) {
     p.grid.resolution = pick(in, {0.05, 0.1, 0.2, 0.15});
     p.grid.block_levels = in->ConsumeIntegralInRange<int>(2, 5);
@@ -99,7 +122,9 @@ MapParams decodeParams(FuzzedDataProvider* in, bool oracle) {
   p.policy.clamp_max = maybe(p.policy.clamp_max, 0.0, 10.0);
   p.prune_threshold = maybe(p.prune_threshold, 0.0, 1.0);
   p.skip_tolerance = maybe(p.skip_tolerance, 0.0, 1.0);
-  p.policy.forget_half_life = in->ConsumeBool() ? 0.0 : maybe(0.3, 0.0, 1e6);
+  p.policy.forget_half_life = maybe(p.policy.forget_half_life, 0.0, 1e6);
+  p.ndt_min_weight = maybe(p.ndt_min_weight, 0.0, 1e6);
+  p.ndt_max_weight = maybe(p.ndt_max_weight, 1.0, 1e9);
   return p;
 }
 
@@ -115,6 +140,8 @@ Scan decodeScan(FuzzedDataProvider* in, bool oracle) {
     s.angle_increment = std::max(fov / static_cast<double>(n), 1e-9) * (in->ConsumeBool() ? 1 : -1);
     s.range_min = in->ConsumeBool() ? 0.0 : in->ConsumeFloatingPointInRange<double>(0.0, 1.0);
     s.range_max = in->ConsumeFloatingPointInRange<double>(0.1, 3.0);
+    s.period = in->ConsumeBool() ? pick(in, {0.0, 0.025, 0.1, 1e-7, 1.0, 50.0})
+                                 : in->ConsumeFloatingPointInRange<double>(0.0, 2.0);
   } else {
     s.pose.x = hostileDouble(in, -50.0, 50.0);
     s.pose.y = hostileDouble(in, -50.0, 50.0);
@@ -156,6 +183,7 @@ void runOracle(const Case& c, WaveletMap* map) {
   const auto cells = static_cast<std::int64_t>(std::ceil(4.5 / c.params.grid.resolution)) + 2;
   wavog_test::DenseReference ref(c.params, CellBox{-cells, -cells, cells, cells});
   for (const auto& s : c.scans) {
+    ref.setGamma(0, map->forgetRate(s.period));  // the rate the map applies to this scan
     map->integrate(s.pose, s.view());
     ref.integrate(s.pose, s.view());
   }
@@ -179,20 +207,23 @@ void runOracle(const Case& c, WaveletMap* map) {
 void describe(const Case& c) {
   const MapParams& p = c.params;
   std::fprintf(stderr,
-               "case: %s; resolution %.17g block_levels %d policy %s init %s lazy %d\n"
+               "case: %s; resolution %.17g block_levels %d policy %s init %s lazy %d threads %d\n"
+               "  reflection %d ndt %d [%.17g, %.17g] half-life %.17g\n"
                "  odd_occ %.17g odd_emp %.17g band_width %.17g max_range %.17g "
                "no_return_clear %.17g\n  gamma %.17g clamp [%.17g, %.17g] prune %.17g skip %.17g\n",
                c.oracle ? "oracle" : "hostile", p.grid.resolution, p.grid.block_levels,
                wavog::toString(p.policy.type), wavog::toString(p.policy.init), p.lazy_forgetting,
+               p.num_threads, p.reflection, p.ndt, p.ndt_min_weight, p.ndt_max_weight,
+               p.policy.forget_half_life,
                p.sensor.odd_occ, p.sensor.odd_emp, p.sensor.band_width, p.sensor.max_range,
                p.sensor.no_return_clear, p.policy.gamma, p.policy.clamp_min, p.policy.clamp_max,
                p.prune_threshold, p.skip_tolerance);
   for (const auto& s : c.scans) {
     std::fprintf(stderr,
                  "  scan: pose (%.17g, %.17g, %.17g) angle_min %.17g increment %.17g range "
-                 "[%.17g, %.17g] %zu beams:",
+                 "[%.17g, %.17g] period %.17g %zu beams:",
                  s.pose.x, s.pose.y, s.pose.theta, s.angle_min, s.angle_increment, s.range_min,
-                 s.range_max, s.ranges.size());
+                 s.range_max, s.period, s.ranges.size());
     for (float r : s.ranges) std::fprintf(stderr, " %.9g", static_cast<double>(r));
     std::fprintf(stderr, "\n");
   }
@@ -232,13 +263,32 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   const auto rasters = wavog_fuzz::readOutEveryScale(map);
+  const auto payloads = wavog_fuzz::readPayloads(map);
   const auto st = map.stats(true);
   WAVOG_FUZZ_CHECK(st.bytes <= st.bytes_reserved, "stats: %zu bytes > %zu reserved", st.bytes,
                    st.bytes_reserved);
   static const std::string path = wavog_fuzz::scratchPath("integrate.wavog");
   map.save(path);
+  if (c.params.num_threads != 1) {
+    // The serial twin: the same scans on one thread save the same bytes.
+    MapParams serial = c.params;
+    serial.num_threads = 1;
+    WaveletMap twin(serial);
+    for (const auto& s : c.scans) twin.integrate(s.pose, s.view());
+    twin.clearBox(c.clear.min_x, c.clear.min_y, c.clear.max_x, c.clear.max_y);
+    static const std::string twin_path = wavog_fuzz::scratchPath("twin.wavog");
+    twin.save(twin_path);
+    WAVOG_FUZZ_CHECK(wavog_fuzz::readFile(path) == wavog_fuzz::readFile(twin_path),
+                     "the threaded map's file differs from its serial twin's");
+  }
   WaveletMap loaded(c.params);
-  loaded.load(path);
+  try {
+    loaded.load(path);
+  } catch (const wavog::MapIoError& e) {
+    WAVOG_FUZZ_CHECK(false, "a saved map does not load: %s", e.what());
+  }
+  WAVOG_FUZZ_CHECK(wavog_fuzz::readPayloads(loaded) == payloads,
+                   "round trip: the payload read-outs differ");
   const auto again = wavog_fuzz::readOutEveryScale(loaded);
   WAVOG_FUZZ_CHECK(rasters.size() == again.size(), "round trip: %zu vs %zu rasters", rasters.size(),
                    again.size());
@@ -250,5 +300,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                    "round trip: %llu vs %llu observed cells",
                    static_cast<unsigned long long>(loaded.stats(true).observed_cells),
                    static_cast<unsigned long long>(st.observed_cells));
+  // The loaded map takes one more scan and stays finite (readOutEveryScale checks), and saves.
+  loaded.integrate(c.scans[0].pose, c.scans[0].view());
+  (void)wavog_fuzz::readOutEveryScale(loaded);
+  (void)wavog_fuzz::readPayloads(loaded);
+  loaded.save(path);
   return 0;
 }
