@@ -2,7 +2,6 @@
 SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
 BUILD ?= $(ROOT)/build
-BUILD_ASAN ?= $(ROOT)/build-asan
 JOBS ?= $(shell nproc)
 # Debian's python (with catkin_pkg) must come before the pyenv shim.
 export PATH := /usr/bin:$(PATH)
@@ -34,18 +33,15 @@ build: deps $(BUILD)/CMakeCache.txt
 test: build
 	@bash $(ROOT)/scripts/run_tests.sh $(BUILD)
 
-## The core tests under AddressSanitizer + UndefinedBehaviorSanitizer.
-test-asan: deps
-	@mkdir -p $(BUILD_ASAN)
-	@cmake -S $(ROOT) -B $(BUILD_ASAN) -DCATKIN_DEVEL_PREFIX=$(BUILD_ASAN)/devel $(CMAKE_ARGS) \
-	  -DWAVOG_SANITIZE="address;undefined;float-cast-overflow" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWAVOG_BUILD_ROS=OFF \
-	  >$(BUILD_ASAN)/configure.log || { cat $(BUILD_ASAN)/configure.log; exit 1; }
-	@bash $(ROOT)/scripts/build.sh $(BUILD_ASAN) $(JOBS) core_tests
+## The core tests under AddressSanitizer + UndefinedBehaviorSanitizer, in the clang tree of
+## `make fuzz` (mk/fuzz.mk): one sanitized build of the core serves both.
+test-asan: fuzz-configure
+	@bash $(ROOT)/scripts/build.sh $(BUILD_FUZZ) $(JOBS) core_tests
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
-	  bash $(ROOT)/scripts/run_tests.sh $(BUILD_ASAN) -L core
+	  bash $(ROOT)/scripts/run_tests.sh $(BUILD_FUZZ) -L core
 
 clean:
-	rm -rf $(BUILD) $(BUILD_ASAN)
+	rm -rf $(BUILD) $(BUILD_FUZZ)
 
 # Further targets (bench, demo, compare, ...) live in mk/*.mk, one file per part.
 -include $(ROOT)/mk/*.mk

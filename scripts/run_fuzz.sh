@@ -4,7 +4,8 @@
 # to BUILD/corpus/<harness>/ (kept between runs), a crashing input to BUILD/artifacts/<harness>/.
 # Each run resumes from BUILD/corpus/<harness>/, so a campaign of hours can be run in parts
 # (make fuzz-long). Prints executions, seconds, exec/s, coverage (edges, features) and corpus
-# size per harness; exit status non-zero if any harness failed.
+# size per harness; exit status non-zero if any harness failed. FUZZ_JOBS (default 1) harnesses
+# run at once.
 set -uo pipefail
 build=${1:?usage: run_fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
 seconds=${2:?usage: run_fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
@@ -16,20 +17,23 @@ harnesses=("$@")
 # Leaks count as findings; UBSan already aborts (-fno-sanitize-recover=all).
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:allocator_may_return_null=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-failed=0
-summary=()
-for h in "${harnesses[@]}"; do
-  bin=$build/fuzz/$h
-  seeds=$root/test/fuzz/corpus/$h
-  work=$build/corpus/$h
-  artifacts=$build/artifacts/$h/
-  log=$build/fuzz_$h.log
+jobs=${FUZZ_JOBS:-1}
+
+# One harness: its run, then its summary line in BUILD/summary_<harness>.txt; status 1 if it failed.
+run_one() {
+  local h=$1
+  local bin=$build/fuzz/$h
+  local seeds=$root/test/fuzz/corpus/$h
+  local work=$build/corpus/$h
+  local artifacts=$build/artifacts/$h/
+  local log=$build/fuzz_$h.log
   mkdir -p "$work" "$artifacts"
   # -timeout: one input taking longer is a hang finding; -rss_limit_mb / -malloc_limit_mb: one
   # input needing more memory is a finding too (the machine is shared).
   "$bin" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
     -print_final_stats=1 -artifact_prefix="$artifacts" "$work" "$seeds" >"$log" 2>&1
-  status=$?
+  local status=$?
+  local execs rate secs last cov ft corp
   execs=$(grep -Eo 'stat::number_of_executed_units: *[0-9]+' "$log" | grep -Eo '[0-9]+$' | tail -1)
   rate=$(grep -Eo 'stat::average_exec_per_sec: *[0-9]+' "$log" | grep -Eo '[0-9]+$' | tail -1)
   secs=$(grep -Eo 'Done [0-9]+ runs in [0-9]+ second' "$log" | grep -Eo '[0-9]+ second' | grep -Eo '[0-9]+' | tail -1)
@@ -39,13 +43,23 @@ for h in "${harnesses[@]}"; do
   ft=$(grep -Eo 'ft: [0-9]+' <<<"$last" | grep -Eo '[0-9]+')
   corp=$(grep -Eo 'corp: [0-9]+' <<<"$last" | grep -Eo '[0-9]+')
   if [ "$status" -ne 0 ]; then
-    failed=1
     echo "fuzz: $h FAILED (status $status); log $log, input in $artifacts:" >&2
     grep -E 'ERROR|runtime error|oracle failed|SUMMARY|Test unit written' "$log" | head -20 >&2
   fi
-  summary+=("$(printf '%-16s %s  %12s executions  %6s s  %8s exec/s  cov %6s  ft %7s  corpus %6s' \
+  printf '%-16s %s  %12s executions  %6s s  %8s exec/s  cov %6s  ft %7s  corpus %6s\n' \
     "$h" "$([ "$status" -eq 0 ] && echo clean || echo FAILED)" "${execs:-?}" "${secs:-?}" \
-    "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}")")
+    "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" >"$build/summary_$h.txt"
+  [ "$status" -eq 0 ]
+}
+
+# FUZZ_JOBS harnesses at once (each is one process, so on as many cores each runs as fast as alone).
+pids=()
+for h in "${harnesses[@]}"; do
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do sleep 1; done
+  run_one "$h" &
+  pids+=($!)
 done
-printf '%s\n' "${summary[@]}"
+failed=0
+for p in "${pids[@]}"; do wait "$p" || failed=1; done
+for h in "${harnesses[@]}"; do cat "$build/summary_$h.txt"; done
 exit "$failed"
