@@ -33,3 +33,23 @@ if(CATKIN_ENABLE_TESTING)
   endif()
 endif()
 
+# ---- The fleet over ROS (test/fleet.test): three simulated vehicles, a bag made at build time ---
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node)
+  set(WAVOG_FLEET_BAG ${CMAKE_BINARY_DIR}/test_data/fleet3.bag)
+  add_custom_command(OUTPUT ${WAVOG_FLEET_BAG}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/test_data
+    COMMAND $<TARGET_FILE:wavog_simulate> --vehicles 3 --duration 28 --seed 5 --out ${WAVOG_FLEET_BAG}
+    DEPENDS wavog_simulate
+    COMMENT "wavog_simulate: the fleet rostest's bag (3 vehicles, 28 s)")
+  add_custom_target(wavog_fleet_test_bag ALL DEPENDS ${WAVOG_FLEET_BAG})
+  find_package(rostest REQUIRED)
+  add_rostest_gtest(test_fleet_system test/fleet.test test/ros/test_fleet_system.cpp)
+  target_include_directories(test_fleet_system SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+  target_link_libraries(test_fleet_system wavog_ros_config wavog_sim wavog_core ${catkin_LIBRARIES}
+                        ${GTEST_LIBRARIES})
+  target_compile_definitions(test_fleet_system PRIVATE
+    WAVOG_FLEET_BAG="${WAVOG_FLEET_BAG}" WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+    WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
+  add_dependencies(test_fleet_system ${PROJECT_NAME}_generate_messages_cpp wavog_mapping_node
+                   wavog_fleet wavog_fleet_nodelet wavog_fleet_test_bag)
+endif()
