@@ -7,6 +7,8 @@ find_package(catkin REQUIRED COMPONENTS
 find_package(yaml-cpp REQUIRED)
 
 add_message_files(DIRECTORY msg FILES InputStatus.msg MapperStatus.msg)
+# The fleet's messages (issue 30: cmake/fleet.cmake).
+add_message_files(DIRECTORY msg FILES PlacedScan.msg VehicleStatus.msg FleetStatus.msg)
 add_service_files(DIRECTORY srv FILES ClearRegion.srv SaveMap.srv)
 generate_messages(DEPENDENCIES std_msgs)
 generate_dynamic_reconfigure_options(cfg/Mapping.cfg)

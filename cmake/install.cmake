@@ -20,7 +20,7 @@ else()
 endif()
 
 # Programs: the node, the tools, the static-tf helper.
-foreach(_t wavog_mapping_node wavog_static_tf wavog_offline wavog_log2bag wavog_simulate
+foreach(_t wavog_mapping_node wavog_fleet wavog_static_tf wavog_offline wavog_log2bag wavog_simulate
            wavog_evaluate wavog_compare wavog_paper)
   if(TARGET ${_t})
     # The project's shared libraries are found beside the program's directory without a sourced

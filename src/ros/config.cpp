@@ -95,6 +95,14 @@ std::vector<int> asIntList(const std::string& key, XmlRpcValue& v) {
   return out;
 }
 
+std::vector<std::string> asStringList(const std::string& key, XmlRpcValue& v) {
+  if (v.getType() != XmlRpcValue::TypeArray) typeError(key, v, "a list of strings");
+  std::vector<std::string> out;
+  for (int i = 0; i < v.size(); ++i)
+    out.push_back(asString(key + "[" + std::to_string(i) + "]", v[i]));
+  return out;
+}
+
 /// Reads one key into a Config.
 struct KeyReader {
   const char* key;
@@ -175,6 +183,19 @@ const std::vector<KeyReader>& readers() {
       {"rate_tolerance",
        [](auto& k, auto& v, Config* c) { c->ros.rate_tolerance = asDouble(k, v); }},
       {"idle_timeout", [](auto& k, auto& v, Config* c) { c->ros.idle_timeout = asDouble(k, v); }},
+      // ---- the fleet (issue 30)
+      {"fleet_stream", [](auto& k, auto& v, Config* c) { c->ros.fleet_stream = asBool(k, v); }},
+      {"vehicle_id", [](auto& k, auto& v, Config* c) { c->ros.vehicle_id = asString(k, v); }},
+      {"fleet_vehicles",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_vehicles = asStringList(k, v); }},
+      {"fleet_reorder_wait",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_reorder_wait = asDouble(k, v); }},
+      {"fleet_stale_timeout",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_stale_timeout = asDouble(k, v); }},
+      {"fleet_integrate_late",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_integrate_late = asBool(k, v); }},
+      {"fleet_max_buffered",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_max_buffered = asInt(k, v); }},
   };
   return kReaders;
 }
@@ -307,6 +328,23 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
         &e, "rate_tolerance (" + fmt(ros.rate_tolerance) + ") must be in [0, 1)");
   check(std::isfinite(ros.idle_timeout) && ros.idle_timeout >= 0.0 && ros.idle_timeout <= 3600.0,
         &e, "idle_timeout (" + fmt(ros.idle_timeout) + ") must be in [0, 3600] s (0: never)");
+  check(static_cast<int>(ros.fleet_vehicles.size()) <= kMaxFleetVehicles, &e,
+        "fleet_vehicles (" + std::to_string(ros.fleet_vehicles.size()) + " entries) must have at most " +
+            std::to_string(kMaxFleetVehicles) + " namespaces");
+  std::set<std::string> vehicles;
+  for (const std::string& v : ros.fleet_vehicles) {
+    check(!v.empty(), &e, "fleet_vehicles entry must be a non-empty namespace");
+    check(vehicles.insert(v).second, &e, "fleet_vehicles entry ('" + v + "') is listed twice");
+  }
+  check(std::isfinite(ros.fleet_reorder_wait) && ros.fleet_reorder_wait >= 0.0 &&
+            ros.fleet_reorder_wait <= 10.0,
+        &e, "fleet_reorder_wait (" + fmt(ros.fleet_reorder_wait) + ") must be in [0, 10] s");
+  check(std::isfinite(ros.fleet_stale_timeout) && ros.fleet_stale_timeout > 0.0 &&
+            ros.fleet_stale_timeout <= 3600.0,
+        &e, "fleet_stale_timeout (" + fmt(ros.fleet_stale_timeout) + ") must be in (0, 3600] s");
+  check(ros.fleet_max_buffered >= 1 && ros.fleet_max_buffered <= 1000000, &e,
+        "fleet_max_buffered (" + std::to_string(ros.fleet_max_buffered) +
+            ") must be in [1, 1000000]");
   return e;
 }
 

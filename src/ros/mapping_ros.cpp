@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "fleet/fleet_receiver.h"
+#include "fleet/fleet_stream.h"
 #include "mapping_ros_impl.h"
 #include "reconfigure.h"
 
@@ -40,7 +42,7 @@ void MappingRos::Impl::warnDroppedPayloads(const std::string& path) const {
   if (held.ndt && !config_.map.ndt) warn("normal-distribution (NDT) cells", "ndt");
 }
 
-MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
+MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, MapperRole role)
     : nh_(nh), pnh_(pnh), config_(loadReportingUnknown(pnh)), map_(config_.map) {
   const RosParams& rp = config_.ros;
   placement_.fixed_frame = rp.map_frame;
@@ -54,7 +56,7 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
     ROS_INFO("%s: loaded map_file '%s'", pnh_.getNamespace().c_str(), rp.map_file.c_str());
     warnDroppedPayloads(rp.map_file);
   }
-  subscribeTf();
+  if (role == MapperRole::kMapper) subscribeTf();
 
   publisher_ = std::make_unique<MapPublisher>(nh_, rp.publish_scales, config_.map.reflection,
                                               config_.map.ndt);  // not yet shared: no lock
@@ -65,7 +67,10 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
   updater_->setHardwareID("wavog_mapping");
   updater_->add("mapper",
                 [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnoseMapper(s); });
-  for (const InputConfig& ic : rp.inputs) addInput(ic);
+  if (role == MapperRole::kMapper) {
+    for (const InputConfig& ic : rp.inputs) addInput(ic);
+  }
+  startFleet(role);
 
   advertiseServices();
   startReconfigure();
@@ -73,6 +78,9 @@ MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
 
   std::string topics;
   for (const auto& in : inputs_) topics += " " + in->topic;
+  for (const auto& v : rp.fleet_vehicles) {
+    if (role == MapperRole::kFleet) topics += " " + v + "/fleet_scans";
+  }
   ROS_INFO("%s: mapping%s into '%s' (policy %s, resolution %g m), publishing at %g Hz",
            pnh_.getNamespace().c_str(), topics.c_str(), rp.map_frame.c_str(),
            wavog::toString(config_.map.policy.type), config_.map.grid.resolution, rp.publish_rate);
@@ -87,6 +95,8 @@ MappingRos::Impl::~Impl() {
   tf_static_sub_.shutdown();
   for (auto& in : inputs_) in->sub.shutdown();
   reconfigure_.reset();
+  fleet_.reset();
+  fleet_stream_.reset();
   inputs_.clear();  // filters before the buffer
 }
 
@@ -239,8 +249,8 @@ std::vector<std::string> MappingRos::Impl::onReconfigure(const wavog_mapping::Ma
   return errors;
 }
 
-MappingRos::MappingRos(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
-    : impl_(std::make_unique<Impl>(nh, pnh)) {}
+MappingRos::MappingRos(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, MapperRole role)
+    : impl_(std::make_unique<Impl>(nh, pnh, role)) {}
 
 MappingRos::~MappingRos() = default;
 

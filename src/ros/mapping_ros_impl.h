@@ -39,6 +39,11 @@
 #include "wavog_mapping/ros/mapping_ros.h"
 #include "wavog_mapping/ros/scan_placement.h"
 
+namespace wavog_fleet {
+class FleetStream;
+class FleetReceiver;
+}  // namespace wavog_fleet
+
 namespace wavog_ros {
 
 using ScanFilter = tf2_ros::MessageFilter<sensor_msgs::LaserScan>;
@@ -78,7 +83,7 @@ struct Input {
 };
 
 struct MappingRos::Impl {
-  Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+  Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, MapperRole role);
   ~Impl();
 
   // ---- construction (mapping_ros.cpp)
@@ -109,6 +114,13 @@ struct MappingRos::Impl {
                        const ScanPlacement& placement);
   void dropLocked(Input* in, DropReason reason, const std::string& detail);
   void warnLocked(Input* in, std::size_t slot, const std::string& text);
+
+  // ---- the fleet (mapping_ros_fleet.cpp, src/ros/fleet/)
+  /// Mapper: the stream when fleet_stream is on. Fleet node: the vehicles' streams, and a tf
+  /// buffer without subscriptions. Throws std::invalid_argument on a parameter the role refuses.
+  void startFleet(MapperRole role);
+  /// The fleet node's core call (the counters and the dirty region, as integrateLocked).
+  wavog::IntegrateStats integratePlacedLocked(const wavog::Pose2& pose, const wavog::ScanView& view);
 
   // ---- what no callback, timer or service lets escape (mapping_ros_scans.cpp)
   /// Counts an exception caught in `where` (and, with an input, the scan as dropped), throttled
@@ -205,6 +217,9 @@ struct MappingRos::Impl {
   std::vector<std::unique_ptr<diagnostic_updater::FrequencyStatus>> freq_;
 
   std::unique_ptr<ReconfigureServer> reconfigure_;
+
+  std::unique_ptr<wavog_fleet::FleetStream> fleet_stream_;  ///< null unless fleet_stream
+  std::unique_ptr<wavog_fleet::FleetReceiver> fleet_;       ///< wavog_fleet only
 };
 
 }  // namespace wavog_ros

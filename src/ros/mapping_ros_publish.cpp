@@ -8,6 +8,7 @@
 #include <boost/make_shared.hpp>
 #include <chrono>
 
+#include "fleet/fleet_receiver.h"
 #include "mapping_ros_impl.h"
 
 namespace wavog_ros {
@@ -58,6 +59,7 @@ void MappingRos::Impl::publishAll() {
   }
   MapPublisher::publish(layers, rp.map_frame, now);
   status_pub_.publish(status);
+  if (fleet_) fleet_->publishStatus(now);
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -87,6 +89,7 @@ wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time&
     status->scans_integrated += c[Counter::kIntegrated];
     status->tf_failures += c.tfFailures();
   }
+  if (fleet_) status->scans_integrated += fleet_->integratedLocked();
   status->clock_jumps = clock_jumps_;
   status->exceptions = exceptions_;
   status->layers_refused = layers_refused_;

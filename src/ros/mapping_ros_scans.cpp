@@ -10,6 +10,7 @@
 #include <chrono>
 #include <sstream>
 
+#include "fleet/fleet_stream.h"
 #include "mapping_ros_impl.h"
 #include "wavog_mapping/ros/conversions.h"
 
@@ -199,17 +200,20 @@ void MappingRos::Impl::onFilterFailure(
 void MappingRos::Impl::onTransformable(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan) {
   // tf lookups outside the lock: the buffer locks itself.
   const ScanPlacement placement = placeScan(*buffer_, *scan, placement_);
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!takePendingLocked(in, scan.get())) return;  // flushed meanwhile (flushPending)
-  if (!placement.placed()) {
-    dropLocked(in, DropReason::kTfUnavailable, placement.error);
-    return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!takePendingLocked(in, scan.get())) return;  // flushed meanwhile (flushPending)
+    if (!placement.placed()) {
+      dropLocked(in, DropReason::kTfUnavailable, placement.error);
+      return;
+    }
+    if (placement.motion_fallback) {
+      ++in->c[Counter::kMotionFallbacks];
+      warnLocked(in, kOtherWarning, "no tf at the end of the sweep: motion compensation skipped");
+    }
+    integrateLocked(in, *scan, placement);
   }
-  if (placement.motion_fallback) {
-    ++in->c[Counter::kMotionFallbacks];
-    warnLocked(in, kOtherWarning, "no tf at the end of the sweep: motion compensation skipped");
-  }
-  integrateLocked(in, *scan, placement);
+  if (fleet_stream_) fleet_stream_->publishQueued();  // without the lock
 }
 
 bool MappingRos::Impl::takePendingLocked(Input* in, const sensor_msgs::LaserScan* scan) {
@@ -253,6 +257,10 @@ void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& 
     return;
   }
   ++c[Counter::kIntegrated];
+  if (fleet_stream_) {  // the very pose and view the core took
+    fleet_stream_->queue(scan.header.stamp, in->topic, pose, view, placement.compensate,
+                         placement.start, placement.end);
+  }
   changed_since_publish_ = true;
   c.last_stamp = scan.header.stamp;
   // Every cell the scan changed lies in the core's touched box (finest cells, in metres here).

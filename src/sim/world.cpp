@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 namespace wavog {
 namespace sim {
@@ -313,6 +315,20 @@ World defaultWorld(double duration) {
                        Vec2(64.0, 24.5), Vec2(5.0, 24.5), Vec2(5.0, 7.8)};
   w.vehicle.path = Trajectory::fromRoute(loop, 3.0, 0.0, 4.0);
   for (int c = 0; c < 4; ++c) w.vehicle.lasers.push_back(cornerLaser(c, kTruckLength, kTruckWidth));
+  return w;
+}
+
+World fleetMember(const World& world, int k, int n) {
+  if (n < 1 || k < 0 || k >= n) {
+    throw std::invalid_argument("fleet member " + std::to_string(k) + " of " + std::to_string(n) +
+                                ": need 0 <= k < n");
+  }
+  World w = world;
+  auto& wps = w.vehicle.path.waypoints;
+  if (k == 0 || wps.size() < 2) return w;
+  const double lap = (wps.back().t - wps.front().t) / 2.0;
+  const double shift = lap * static_cast<double>(k) / static_cast<double>(n);
+  for (Waypoint& p : wps) p.t -= shift;
   return w;
 }
 

@@ -55,6 +55,10 @@ struct Options {
   // Error of the /tf poses (the lasers measure from the true pose).
   wavog::sim::PoseNoiseParams pose_noise;  // its seed: poseNoise()
   long pose_seed = -1;                     // < 0: --seed
+  // A fleet: vehicle k (1..vehicles) in namespace <prefix>k (topics /<prefix>k/..., frames
+  // <prefix>k/...), on the route started k-1 / vehicles of a lap further (fleetMember).
+  long vehicles = 1;
+  std::string vehicle_prefix = "v";
 };
 
 /// An angle option given in degrees, kept in radians (read whole, as addNumber).
@@ -120,12 +124,21 @@ void addOptions(CLI::App* app, Options* o) {
   wavog_tools::addNumber(app, "--truth-every", &o->truth_every, "ground-truth snapshot period (s)");
   app->add_option("--write-world", o->write_world,
                   "write the world as YAML (e.g. to edit the default) and go on");
+  wavog_tools::addInteger(app, "--vehicles", &o->vehicles, 1,
+                          "vehicles of a fleet, each with the world's lasers, on the route spread "
+                          "over a lap; > 1: topics /<prefix>k/..., frames <prefix>k/...");
+  app->add_option("--vehicle-prefix", o->vehicle_prefix, "namespace prefix of the fleet's vehicles")
+      ->capture_default_str();
   addPoseNoiseOptions(app, o);
 }
 
 void validate(const Options& o) {
   if (!(o.truth_resolution > 0.0)) throw std::invalid_argument("--truth-resolution must be > 0");
   if (!(o.truth_every > 0.0)) throw std::invalid_argument("--truth-every must be > 0");
+  if (o.vehicles < 1 || o.vehicles > 64) throw std::invalid_argument("--vehicles must be in [1, 64]");
+  if (o.vehicles > 1 && o.vehicle_prefix.find_first_of("/ ") != std::string::npos) {
+    throw std::invalid_argument("--vehicle-prefix must be a plain name (no '/' or space)");
+  }
   for (const std::string& e : poseNoise(o).validate()) throw std::invalid_argument(e);
 }
 
@@ -200,14 +213,25 @@ int run(const Options& o) {
   }
   if (!o.write_world.empty()) std::ofstream(o.write_world) << wavog::sim::worldToYaml(world);
 
-  wavog::sim::ScanSimulator sim(world, o.seed);
-  const std::size_t total = sim.scanCount();
   rosbag::Bag bag(o.bag, rosbag::bagmode::Write);
-
   const ros::Time t0(kEpoch);
+  // One vehicle: names as before; a fleet: each vehicle under its namespace.
+  std::vector<World> worlds;
+  std::vector<std::string> names;
+  for (long k = 0; k < o.vehicles; ++k) {
+    worlds.push_back(wavog::sim::fleetMember(world, static_cast<int>(k), static_cast<int>(o.vehicles)));
+    names.push_back(o.vehicles > 1 ? o.vehicle_prefix + std::to_string(k + 1) : "");
+  }
+  auto frame = [](const std::string& ns, const std::string& f) { return ns.empty() ? f : ns + "/" + f; };
+  auto topic = [](const std::string& ns, const std::string& t) {
+    return ns.empty() ? absoluteTopic(t) : "/" + ns + absoluteTopic(t);
+  };
   tf2_msgs::TFMessage statics;
-  for (const LaserParams& l : world.vehicle.lasers) {
-    statics.transforms.push_back(transformMsg(o.base_frame, l.frame_id, l.mount, t0));
+  for (std::size_t k = 0; k < worlds.size(); ++k) {
+    for (const LaserParams& l : worlds[k].vehicle.lasers) {
+      statics.transforms.push_back(
+          transformMsg(frame(names[k], o.base_frame), frame(names[k], l.frame_id), l.mount, t0));
+    }
   }
   // Latched, so that `rosbag play` re-latches it. A custom connection header replaces rosbag's
   // own, so it carries the type fields as well.
@@ -220,35 +244,47 @@ int run(const Options& o) {
   bag.write("/tf_static", t0, statics, latched);
 
   const wavog::sim::PoseNoiseParams noise = poseNoise(o);
-  std::vector<std::size_t> per_laser(world.vehicle.lasers.size(), 0);
-  SimScan scan;
-  std::size_t done = 0;
-  while (sim.next(&scan)) {
-    const ros::Time stamp = t0 + ros::Duration(scan.stamp);
+  std::size_t done = 0, tf_count = 0;
+  std::ostringstream summary;
+  for (std::size_t k = 0; k < worlds.size(); ++k) {
+    const World& w = worlds[k];
+    const std::string base = frame(names[k], o.base_frame);
+    const std::string map_frame = o.map_frame;
+    // Each vehicle its own noise (the same seed for one vehicle, as before).
+    wavog::sim::ScanSimulator sim(w, o.seed + k);
+    std::vector<std::size_t> per_laser(w.vehicle.lasers.size(), 0);
+    SimScan scan;
+    while (sim.next(&scan)) {
+      const ros::Time stamp = t0 + ros::Duration(scan.stamp);
+      tf2_msgs::TFMessage tf;
+      const wavog::Pose2 told = wavog::sim::withPoseError(w, scan, noise).vehicle_pose;
+      tf.transforms.push_back(transformMsg(map_frame, base, told, stamp));
+      bag.write("/tf", stamp, tf);
+      ++tf_count;
+      const LaserParams& laser = w.vehicle.lasers[static_cast<std::size_t>(scan.laser)];
+      LaserParams named = laser;
+      named.frame_id = frame(names[k], laser.frame_id);
+      bag.write(topic(names[k], laser.topic), stamp, scanMsg(scan, named, stamp));
+      ++per_laser[static_cast<std::size_t>(scan.laser)];
+      if (++done % 2000 == 0) std::cerr << "\rwavog_simulate: " << done << " scans";
+    }
+    // One more pose after the last scan, so a tf lookup at the last stamp never extrapolates.
+    const ros::Time end = t0 + ros::Duration(w.duration);
     tf2_msgs::TFMessage tf;
-    const wavog::Pose2 told = wavog::sim::withPoseError(world, scan, noise).vehicle_pose;
-    tf.transforms.push_back(transformMsg(o.map_frame, o.base_frame, told, stamp));
-    bag.write("/tf", stamp, tf);
-    const LaserParams& laser = world.vehicle.lasers[static_cast<std::size_t>(scan.laser)];
-    bag.write(absoluteTopic(laser.topic), stamp, scanMsg(scan, laser, stamp));
-    ++per_laser[static_cast<std::size_t>(scan.laser)];
-    if (++done % 2000 == 0) std::cerr << "\rwavog_simulate: " << done << " / " << total << " scans";
+    tf.transforms.push_back(transformMsg(map_frame, base, w.vehicle.path.at(w.duration), end));
+    bag.write("/tf", end, tf);
+    ++tf_count;
+    for (std::size_t i = 0; i < per_laser.size(); ++i) {
+      summary << (summary.tellp() > 0 ? ", " : " ") << per_laser[i] << " on "
+              << topic(names[k], w.vehicle.lasers[i].topic);
+    }
   }
-  // One more pose after the last scan, so a tf lookup at the last stamp never extrapolates.
-  const ros::Time end = t0 + ros::Duration(world.duration);
-  tf2_msgs::TFMessage tf;
-  tf.transforms.push_back(
-      transformMsg(o.map_frame, o.base_frame, world.vehicle.path.at(world.duration), end));
-  bag.write("/tf", end, tf);
   bag.close();
 
   std::cerr << "\rwavog_simulate: world '" << world.name << "', seed " << o.seed << ", "
-            << world.duration << " s: wrote " << o.bag << " with";
-  for (std::size_t i = 0; i < per_laser.size(); ++i) {
-    std::cerr << (i ? ", " : " ") << per_laser[i] << " on "
-              << absoluteTopic(world.vehicle.lasers[i].topic);
-  }
-  std::cerr << ", " << done + 1 << " on /tf (" << o.map_frame << " -> " << o.base_frame
+            << world.duration << " s: wrote " << o.bag << " with" << summary.str() << ", "
+            << tf_count << " on /tf (" << o.map_frame << " -> "
+            << (o.vehicles > 1 ? o.vehicle_prefix + "<k>/" : "") << o.base_frame
             << "), 1 on /tf_static\n";
   if (!o.truth_dir.empty()) {
     writeTruth(world, o);

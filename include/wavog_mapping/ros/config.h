@@ -71,7 +71,30 @@ struct RosParams {
   /// bag): scans still waiting for tf are integrated with the latest tf and every layer is
   /// published once more; in [0, 3600], 0: never.
   double idle_timeout = 2.0;
+
+  // ---- The fleet (issue 30; src/ros/fleet/) ----
+  /// Mapper: publish every scan it integrates, placed in map_frame, on fleet_scans
+  /// (wavog_mapping/PlacedScan) for a fleet node. Off: no publisher, no cost.
+  bool fleet_stream = false;
+  /// Mapper: the vehicle id in the stream; empty: the node's namespace.
+  std::string vehicle_id;
+  /// Fleet node: the vehicles' namespaces (1 to kMaxFleetVehicles); it subscribes to
+  /// <namespace>/fleet_scans. Mappers ignore it.
+  std::vector<std::string> fleet_vehicles;
+  /// Fleet node: how long (wall s) a scan waits in the reorder buffer for older scans of other
+  /// vehicles before it is integrated, in [0, 10].
+  double fleet_reorder_wait = 0.3;
+  /// Fleet node: wall s without a message after which a vehicle is stale, in (0, 3600].
+  double fleet_stale_timeout = 2.0;
+  /// Fleet node: a scan older than the newest integrated one is integrated anyway (true) or
+  /// dropped (false); counted either way.
+  bool fleet_integrate_late = true;
+  /// Fleet node: most scans in the reorder buffer, in [1, 1000000]; beyond, refused (counted).
+  int fleet_max_buffered = 20000;
 };
+
+/// Most vehicles one fleet node follows.
+constexpr int kMaxFleetVehicles = 64;
 
 /// Everything the mapper reads.
 struct Config {

@@ -13,12 +13,17 @@
 
 namespace wavog_ros {
 
+/// What a MappingRos maps from: LaserScans and tf (a vehicle's mapper), or the PlacedScan
+/// streams of the vehicles listed in fleet_vehicles (wavog_fleet; src/ros/fleet/).
+enum class MapperRole { kMapper, kFleet };
+
 class MappingRos {
  public:
   /// Reads the configuration from `pnh` (one loader, config.h), loads map_file, subscribes to the
   /// inputs (topics relative to `nh`) and starts the timers. Throws std::invalid_argument naming
   /// the bad parameter and its range, or std::runtime_error for an unreadable map_file.
-  MappingRos(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+  MappingRos(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+             MapperRole role = MapperRole::kMapper);
   ~MappingRos();
   MappingRos(const MappingRos&) = delete;
   MappingRos& operator=(const MappingRos&) = delete;

@@ -111,6 +111,12 @@ LaserParams cornerLaser(int corner, double length, double width);
 /// through it. `duration` (s) shortens or lengthens the run; events keep their times.
 World defaultWorld(double duration = 60.0);
 
+/// Vehicle `k` of a fleet of `n` (0 <= k < n) in `world`: the same lasers on the same route, started
+/// k / n of a lap further along it (a lap: half the route's duration, the car park's truck drives
+/// its loop twice), so that n vehicles spread over the site. Vehicle 0 is `world` unchanged.
+/// Throws std::invalid_argument for k outside [0, n).
+World fleetMember(const World& world, int k, int n);
+
 /// A small scenario for tests: one laser at rest facing a wall, one parked car in between that
 /// vanishes at `depart_time`. `duration` sets the number of scans (rate 40 Hz).
 World testWorld(double depart_time, double duration, double noise_sigma = 0.0);

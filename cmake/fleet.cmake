@@ -1,0 +1,55 @@
+# A fleet's map over the ROS graph (issue 30): the mapper's stream of placed scans and the fleet
+# node (wavog_fleet, node and nodelet) join the mapper class wavog_ros; their tests. The messages
+# are declared in cmake/catkin.cmake (PlacedScan, VehicleStatus, FleetStatus).
+if(NOT TARGET wavog_ros)
+  return()
+endif()
+
+target_sources(wavog_ros PRIVATE
+  src/ros/mapping_ros_fleet.cpp
+  src/ros/fleet/placed_scan.cpp
+  src/ros/fleet/fleet_stream.cpp
+  src/ros/fleet/fleet_receiver.cpp)
+
+add_library(wavog_fleet_nodelet src/ros/fleet/fleet_nodelet.cpp)
+target_link_libraries(wavog_fleet_nodelet PRIVATE wavog_ros)
+target_compile_options(wavog_fleet_nodelet PRIVATE ${WAVOG_WARNINGS})
+
+add_executable(wavog_fleet src/ros/fleet/fleet_node.cpp)
+target_link_libraries(wavog_fleet PRIVATE wavog_ros)
+target_compile_options(wavog_fleet PRIVATE ${WAVOG_WARNINGS})
+set_target_properties(wavog_fleet PROPERTIES
+  RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+
+if(CATKIN_ENABLE_TESTING)
+  # The merge rule without a master: the reorder buffer, the message checks, and the fleet map
+  # equal to one map of every vehicle's scans in stamp order, for every policy.
+  if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_fleet_merge.cpp AND TARGET wavog_sim)
+    catkin_add_gtest(test_fleet_merge test/ros/test_fleet_merge.cpp)
+    if(TARGET test_fleet_merge)
+      target_include_directories(test_fleet_merge PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
+      target_link_libraries(test_fleet_merge wavog_ros wavog_sim ${GTEST_MAIN_LIBRARIES})
+    endif()
+  endif()
+endif()
+
+# ---- The fleet over ROS (test/fleet.test): three simulated vehicles, a bag made at build time ---
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node)
+  set(WAVOG_FLEET_BAG ${CMAKE_BINARY_DIR}/test_data/fleet3.bag)
+  add_custom_command(OUTPUT ${WAVOG_FLEET_BAG}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/test_data
+    COMMAND $<TARGET_FILE:wavog_simulate> --vehicles 3 --duration 28 --seed 5 --out ${WAVOG_FLEET_BAG}
+    DEPENDS wavog_simulate
+    COMMENT "wavog_simulate: the fleet rostest's bag (3 vehicles, 28 s)")
+  add_custom_target(wavog_fleet_test_bag ALL DEPENDS ${WAVOG_FLEET_BAG})
+  find_package(rostest REQUIRED)
+  add_rostest_gtest(test_fleet_system test/fleet.test test/ros/test_fleet_system.cpp)
+  target_include_directories(test_fleet_system SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+  target_link_libraries(test_fleet_system wavog_ros_config wavog_sim wavog_core ${catkin_LIBRARIES}
+                        ${GTEST_LIBRARIES})
+  target_compile_definitions(test_fleet_system PRIVATE
+    WAVOG_FLEET_BAG="${WAVOG_FLEET_BAG}" WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+    WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
+  add_dependencies(test_fleet_system ${PROJECT_NAME}_generate_messages_cpp wavog_mapping_node
+                   wavog_fleet wavog_fleet_nodelet wavog_fleet_test_bag)
+endif()

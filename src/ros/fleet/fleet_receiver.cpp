@@ -1,0 +1,250 @@
+// FleetReceiver (see fleet_receiver.h): subscriptions, checks, the reorder buffer, per-vehicle
+// counters, ~fleet_status and the per-vehicle diagnostics.
+#include "fleet_receiver.h"
+
+#include <ros/serialization.h>
+
+#include <algorithm>
+#include <boost/make_shared.hpp>
+#include <stdexcept>
+
+namespace wavog_fleet {
+namespace {
+
+/// Period (wall s) of the release timer: the reorder wait is kept to within this.
+constexpr double kReleasePeriod = 0.01;
+/// Seconds between two warnings about one vehicle.
+constexpr double kWarnPeriod = 5.0;
+/// Messages roscpp holds per vehicle before the callback (4 lasers x 40 Hz for 10 s).
+constexpr std::uint32_t kSubscriberQueue = 2000;
+
+std::int64_t toNs(const ros::Time& t) { return static_cast<std::int64_t>(t.toNSec()); }
+
+}  // namespace
+
+struct FleetReceiver::Vehicle {
+  int index = 0;
+  std::string name;
+  std::string topic;
+  ros::Subscriber sub;
+  wavog_mapping::VehicleStatus c;  ///< counters (topic, vehicle filled at start)
+  ros::WallTime last_receipt;      ///< zero: nothing yet
+  ros::WallTime last_warn;
+  bool has_index = false;
+  std::uint64_t next_index = 0;
+  bool stale_reported = false;
+  double lag_max_period = 0.0;
+};
+
+FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
+                             const wavog_ros::RosParams& ros, std::mutex* mutex,
+                             IntegrateFn integrate, diagnostic_updater::Updater* updater)
+    : nh_(nh),
+      pnh_(pnh),
+      map_frame_(ros.map_frame),
+      stale_timeout_(ros.fleet_stale_timeout),
+      integrate_late_(ros.fleet_integrate_late),
+      reorder_wait_(ros.fleet_reorder_wait),
+      mutex_(mutex),
+      integrate_(std::move(integrate)),
+      buffer_(ros.fleet_reorder_wait, static_cast<std::size_t>(ros.fleet_max_buffered)) {
+  if (ros.fleet_vehicles.empty()) {
+    throw std::invalid_argument(
+        "fleet_vehicles must list 1 to " + std::to_string(wavog_ros::kMaxFleetVehicles) +
+        " vehicle namespaces for wavog_fleet (config/fleet.yaml)");
+  }
+  status_pub_ = pnh_.advertise<wavog_mapping::FleetStatus>("fleet_status", 10);
+  for (const std::string& name : ros.fleet_vehicles) {
+    auto v = std::make_unique<Vehicle>();
+    v->index = static_cast<int>(vehicles_.size());
+    v->name = name;
+    v->topic = nh_.resolveName(ros::names::append(name, "fleet_scans"));
+    v->c.vehicle = name;
+    v->c.topic = v->topic;
+    Vehicle* raw = v.get();
+    v->sub = nh_.subscribe<wavog_mapping::PlacedScan>(
+        v->topic, kSubscriberQueue,
+        boost::function<void(const ros::MessageEvent<const wavog_mapping::PlacedScan>&)>(
+            [this, raw](const ros::MessageEvent<const wavog_mapping::PlacedScan>& e) {
+              try {
+                onMessage(raw, e);
+              } catch (const std::exception& ex) {
+                ROS_ERROR_THROTTLE(kWarnPeriod, "%s: exception in the fleet callback: %s",
+                                   raw->topic.c_str(), ex.what());
+              }
+            }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+    updater->add(name + " vehicle", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {
+      diagnose(raw, s);
+    });
+    vehicles_.push_back(std::move(v));
+  }
+  release_timer_ = nh_.createWallTimer(ros::WallDuration(kReleasePeriod),
+                                       [this](const ros::WallTimerEvent&) { onReleaseTimer(); });
+}
+
+FleetReceiver::~FleetReceiver() {
+  release_timer_.stop();
+  for (auto& v : vehicles_) v->sub.shutdown();
+}
+
+void FleetReceiver::onMessage(Vehicle* v,
+                              const ros::MessageEvent<const wavog_mapping::PlacedScan>& event) {
+  const Item m = event.getConstMessage();
+  const ros::WallTime now = ros::WallTime::now();
+  std::lock_guard<std::mutex> lock(*mutex_);
+  wavog_mapping::VehicleStatus& c = v->c;
+  ++c.received;
+  c.bytes += ros::serialization::serializationLength(*m);
+  v->last_receipt = now;
+  if (v->stale_reported) {
+    v->stale_reported = false;
+    ROS_INFO("%s: vehicle '%s' streams again", pnh_.getNamespace().c_str(), v->name.c_str());
+  }
+  std::string detail;
+  const Refusal r = checkPlacedScan(*m, map_frame_, &detail);
+  if (r != Refusal::kNone) {
+    std::uint64_t* counter = r == Refusal::kVersion  ? &c.dropped_version
+                             : r == Refusal::kFrame  ? &c.dropped_frame
+                             : r == Refusal::kBadPose ? &c.dropped_bad_pose
+                                                      : &c.dropped_bad_size;
+    ++*counter;
+    warnLocked(v, std::string("message refused (") + toString(r) + ", " +
+                      std::to_string(*counter) + " so far): " + detail);
+    return;
+  }
+  // Gaps in the stream's index: messages lost on the way (a smaller index: the mapper restarted).
+  if (v->has_index && m->index > v->next_index) c.lost += m->index - v->next_index;
+  v->has_index = true;
+  v->next_index = m->index + 1;
+  c.last_stamp = m->header.stamp;
+  const OrderKey key{toNs(m->header.stamp), v->index, m->index};
+  switch (buffer_.push(key, now.toSec(), m)) {
+    case Admission::kQueued:
+      return;
+    case Admission::kOverflow:
+      ++c.dropped_overflow;
+      warnLocked(v, "message refused: the reorder buffer holds fleet_max_buffered scans (" +
+                        std::to_string(buffer_.size()) + ")");
+      return;
+    case Admission::kLate:
+      if (integrate_late_) {
+        ++c.integrated_late;
+        integrateLocked(v, *m);
+      } else {
+        ++c.dropped_late;
+      }
+      warnLocked(v, "scan stamped " + std::to_string(m->header.stamp.toSec()) +
+                        " s arrived after a newer one was integrated (" +
+                        (integrate_late_ ? std::to_string(c.integrated_late) + " integrated late"
+                                         : std::to_string(c.dropped_late) + " dropped") +
+                        " so far; fleet_reorder_wait " + std::to_string(reorder_wait_) + " s)");
+      return;
+  }
+}
+
+void FleetReceiver::onReleaseTimer() {
+  const double now = ros::WallTime::now().toSec();
+  std::lock_guard<std::mutex> lock(*mutex_);
+  buffer_.release(now, [this](const OrderKey& key, const Item& m) {
+    integrateLocked(vehicles_[static_cast<std::size_t>(key.vehicle)].get(), *m);
+  });
+}
+
+std::size_t FleetReceiver::releaseAll() {
+  std::lock_guard<std::mutex> lock(*mutex_);
+  return buffer_.releaseAll([this](const OrderKey& key, const Item& m) {
+    integrateLocked(vehicles_[static_cast<std::size_t>(key.vehicle)].get(), *m);
+  });
+}
+
+void FleetReceiver::integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan& m) {
+  const wavog::IntegrateStats st = integrate_(placedPose(m), placedView(m));
+  wavog_mapping::VehicleStatus& c = v->c;
+  if (st.status != wavog::ScanStatus::kOk) {
+    ++c.dropped_refused;
+    warnLocked(v, std::string("scan refused by the core: ") + wavog::toString(st.status));
+    return;
+  }
+  ++c.integrated;
+  if (integrated_stamp_ < m.header.stamp) integrated_stamp_ = m.header.stamp;
+  const double lag = (ros::Time::now() - m.header.stamp).toSec();
+  c.lag = lag;
+  v->lag_max_period = std::max(v->lag_max_period, lag);
+}
+
+std::uint64_t FleetReceiver::integratedLocked() const {
+  std::uint64_t n = 0;
+  for (const auto& v : vehicles_) n += v->c.integrated;
+  return n;
+}
+
+bool FleetReceiver::staleLocked(const Vehicle* v, const ros::WallTime& now) const {
+  return v->last_receipt.isZero() || (now - v->last_receipt).toSec() > stale_timeout_;
+}
+
+void FleetReceiver::publishStatus(const ros::Time& now) {
+  auto s = boost::make_shared<wavog_mapping::FleetStatus>();
+  const ros::WallTime wall = ros::WallTime::now();
+  {
+    std::lock_guard<std::mutex> lock(*mutex_);
+    s->header.stamp = now;
+    s->header.frame_id = map_frame_;
+    for (auto& v : vehicles_) {
+      v->c.stale = staleLocked(v.get(), wall);
+      v->c.lag_max = v->lag_max_period;
+      v->lag_max_period = 0.0;
+      s->vehicles.push_back(v->c);
+    }
+    s->buffered = buffer_.size();
+    s->reorder_wait = reorder_wait_;
+    s->integrated_stamp = integrated_stamp_;
+  }
+  status_pub_.publish(s);
+}
+
+void FleetReceiver::diagnose(const Vehicle* v, diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::lock_guard<std::mutex> lock(*mutex_);
+  const ros::WallTime now = ros::WallTime::now();
+  const wavog_mapping::VehicleStatus& c = v->c;
+  const std::uint64_t refused = c.dropped_version + c.dropped_frame + c.dropped_bad_pose +
+                                c.dropped_bad_size + c.dropped_refused + c.dropped_overflow;
+  if (staleLocked(v, now)) {
+    if (v->last_receipt.isZero()) {
+      stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "stale: nothing received yet");
+    } else {
+      stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                    "stale: nothing received for %.1f s (its cells stay in the map)",
+                    (now - v->last_receipt).toSec());
+    }
+  } else if (refused > 0) {
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu messages refused",
+                  static_cast<unsigned long long>(refused));
+  } else {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "streaming");
+  }
+  stat.add("topic", c.topic);
+  stat.add("received", c.received);
+  stat.add("bytes", c.bytes);
+  stat.add("integrated", c.integrated);
+  stat.add("integrated late", c.integrated_late);
+  stat.add("lost", c.lost);
+  stat.add("dropped late", c.dropped_late);
+  stat.add("dropped version", c.dropped_version);
+  stat.add("dropped frame", c.dropped_frame);
+  stat.add("dropped bad pose", c.dropped_bad_pose);
+  stat.add("dropped bad size", c.dropped_bad_size);
+  stat.add("dropped refused by core", c.dropped_refused);
+  stat.add("dropped overflow", c.dropped_overflow);
+  stat.add("last stamp", c.last_stamp.toSec());
+  stat.add("lag (s)", c.lag);
+}
+
+void FleetReceiver::warnLocked(Vehicle* v, const std::string& text) {
+  const ros::WallTime now = ros::WallTime::now();
+  if (!v->last_warn.isZero() && (now - v->last_warn).toSec() < kWarnPeriod) return;
+  v->last_warn = now;
+  ROS_WARN("%s: %s", v->topic.c_str(), text.c_str());
+}
+
+}  // namespace wavog_fleet

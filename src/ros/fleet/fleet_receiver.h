@@ -1,0 +1,76 @@
+// FleetReceiver: the fleet node's inputs (wavog_fleet). One subscription per vehicle namespace
+// (<ns>/fleet_scans, PlacedScan), each message checked (placed_scan.h), then held in a
+// ReorderBuffer and handed to the map in stamp order after at most fleet_reorder_wait (wall s);
+// late, foreign and overflowing messages are counted by vehicle and reason, warned with a
+// throttle. A vehicle silent for fleet_stale_timeout is stale (diagnostics WARN, ~fleet_status);
+// nothing waits for it, and its cells stay in the map like any region no longer observed.
+// Locking: every member is guarded by the mapper's one mutex (passed in), and the integration
+// callback runs under it.
+#ifndef WAVOG_MAPPING_SRC_ROS_FLEET_FLEET_RECEIVER_H_
+#define WAVOG_MAPPING_SRC_ROS_FLEET_FLEET_RECEIVER_H_
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "placed_scan.h"
+#include "reorder_buffer.h"
+#include "wavog_mapping/FleetStatus.h"
+#include "wavog_mapping/PlacedScan.h"
+#include "wavog_mapping/core/wavelet_map.h"
+#include "wavog_mapping/ros/config.h"
+
+namespace wavog_fleet {
+
+/// The core call of the mapper that owns the map: called under its lock.
+using IntegrateFn = std::function<wavog::IntegrateStats(const wavog::Pose2&, const wavog::ScanView&)>;
+
+class FleetReceiver {
+ public:
+  /// Subscribes to every vehicle of `ros.fleet_vehicles` (relative to `nh`); adds one diagnostics
+  /// task per vehicle to `updater`; publishes ~fleet_status on `pnh`. Throws
+  /// std::invalid_argument if the list is empty.
+  FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh, const wavog_ros::RosParams& ros,
+                std::mutex* mutex, IntegrateFn integrate, diagnostic_updater::Updater* updater);
+  ~FleetReceiver();
+
+  /// Scans integrated, all vehicles (under the mapper's lock).
+  std::uint64_t integratedLocked() const;
+  /// Builds and publishes ~fleet_status (takes the lock itself).
+  void publishStatus(const ros::Time& now);
+  /// Integrates everything still buffered, in order (takes the lock itself); returns how many.
+  std::size_t releaseAll();
+
+ private:
+  struct Vehicle;
+  using Item = wavog_mapping::PlacedScan::ConstPtr;
+
+  void onMessage(Vehicle* v, const ros::MessageEvent<const wavog_mapping::PlacedScan>& event);
+  void onReleaseTimer();
+  void integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan& m);
+  void warnLocked(Vehicle* v, const std::string& text);
+  void diagnose(const Vehicle* v, diagnostic_updater::DiagnosticStatusWrapper& stat);
+  bool staleLocked(const Vehicle* v, const ros::WallTime& now) const;
+
+  ros::NodeHandle nh_, pnh_;
+  std::string map_frame_;
+  double stale_timeout_;
+  bool integrate_late_;
+  double reorder_wait_;
+  std::mutex* mutex_;
+  IntegrateFn integrate_;
+  std::vector<std::unique_ptr<Vehicle>> vehicles_;
+  ReorderBuffer<Item> buffer_;
+  ros::Time integrated_stamp_;
+  ros::Publisher status_pub_;
+  ros::WallTimer release_timer_;
+};
+
+}  // namespace wavog_fleet
+
+#endif  // WAVOG_MAPPING_SRC_ROS_FLEET_FLEET_RECEIVER_H_

@@ -1,0 +1,312 @@
+// The fleet's merge rule without a master (issue 30): the reorder buffer integrates in stamp order
+// within its bounded wait whatever the arrival order, counts late and overflowing items, never
+// waits for a silent vehicle; foreign PlacedScans are refused by name; and the fleet map (scans of
+// three simulated vehicles through PlacedScan, serialisation, arrival out of order, the reorder
+// buffer) equals, cell for cell, one map fed all the scans in stamp order, for every policy.
+#include <gtest/gtest.h>
+#include <ros/serialization.h>
+
+#include <algorithm>
+#include <cstring>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <tuple>
+#include <vector>
+
+#include "fleet/placed_scan.h"
+#include "fleet/reorder_buffer.h"
+#include "wavog_mapping/core/wavelet_map.h"
+#include "wavog_mapping/sim/laser_sim.h"
+#include "wavog_mapping/sim/world.h"
+
+namespace {
+
+using wavog_fleet::Admission;
+using wavog_fleet::OrderKey;
+using wavog_fleet::Refusal;
+using wavog_fleet::ReorderBuffer;
+
+OrderKey key(std::int64_t stamp, int vehicle, std::uint64_t index) {
+  return OrderKey{stamp, vehicle, index};
+}
+
+// ---- the reorder buffer ----------------------------------------------------------------------
+
+TEST(ReorderBuffer, ReleasesInKeyOrderWhateverTheArrivalOrder) {
+  std::mt19937 rng(7);
+  std::vector<OrderKey> keys;
+  for (int v = 0; v < 3; ++v)
+    for (std::uint64_t i = 0; i < 200; ++i) keys.push_back(key(static_cast<std::int64_t>(i) * 25, v, i));
+  // Each item arrives up to 0.2 s after its stamp (ms units: stamp / 1000 s), in a random order
+  // among those; the wait (0.3 s) covers the spread, so nothing is late.
+  std::vector<std::pair<double, OrderKey>> arrivals;
+  std::uniform_real_distribution<double> delay(0.0, 0.2);
+  for (const OrderKey& k : keys) arrivals.push_back({k.stamp_ns / 1000.0 + delay(rng), k});
+  std::sort(arrivals.begin(), arrivals.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  ReorderBuffer<int> buffer(0.3, 100000);
+  std::vector<OrderKey> out;
+  auto sink = [&](const OrderKey& k, int) { out.push_back(k); };
+  for (const auto& a : arrivals) {
+    buffer.release(a.first, sink);
+    ASSERT_EQ(buffer.push(a.second, a.first, 0), Admission::kQueued);
+  }
+  buffer.release(1e9, sink);
+  EXPECT_EQ(buffer.size(), 0u);
+  std::vector<OrderKey> sorted = keys;
+  std::sort(sorted.begin(), sorted.end());
+  ASSERT_EQ(out.size(), sorted.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    EXPECT_FALSE(out[i] < sorted[i] || sorted[i] < out[i]) << "position " << i;
+  }
+}
+
+TEST(ReorderBuffer, HoldsAnItemForTheWaitAndNoLonger) {
+  ReorderBuffer<int> buffer(0.5, 10);
+  int released = 0;
+  auto sink = [&](const OrderKey&, int) { ++released; };
+  ASSERT_EQ(buffer.push(key(100, 0, 0), 10.0, 0), Admission::kQueued);
+  EXPECT_EQ(buffer.release(10.49, sink), 0u);
+  EXPECT_EQ(buffer.release(10.5, sink), 1u);
+  EXPECT_EQ(released, 1);
+}
+
+TEST(ReorderBuffer, ASilentVehicleHoldsNothingUp) {
+  // Vehicle 1 never sends again: vehicle 0's items still go out after the wait.
+  ReorderBuffer<int> buffer(0.2, 10);
+  std::vector<OrderKey> out;
+  auto sink = [&](const OrderKey& k, int) { out.push_back(k); };
+  ASSERT_EQ(buffer.push(key(5, 1, 0), 0.0, 0), Admission::kQueued);
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_EQ(buffer.push(key(10 + i, 0, static_cast<std::uint64_t>(i)), 1.0 + i, 0),
+              Admission::kQueued);
+    buffer.release(1.0 + i + 0.2, sink);
+  }
+  EXPECT_EQ(out.size(), 6u);
+  EXPECT_EQ(buffer.size(), 0u);
+}
+
+TEST(ReorderBuffer, AnItemOlderThanTheLastReleasedIsLate) {
+  ReorderBuffer<int> buffer(0.1, 10);
+  auto sink = [](const OrderKey&, int) {};
+  ASSERT_EQ(buffer.push(key(100, 0, 0), 0.0, 0), Admission::kQueued);
+  ASSERT_EQ(buffer.release(0.2, sink), 1u);
+  EXPECT_EQ(buffer.push(key(99, 1, 0), 0.3, 0), Admission::kLate);
+  // Same stamp, lower vehicle: it would have gone first, so it is late too.
+  EXPECT_EQ(buffer.push(key(100, -1, 0), 0.3, 0), Admission::kLate);
+  EXPECT_EQ(buffer.push(key(100, 1, 0), 0.3, 0), Admission::kQueued);
+  EXPECT_EQ(buffer.size(), 1u);
+}
+
+TEST(ReorderBuffer, RefusesBeyondItsCapacity) {
+  ReorderBuffer<int> buffer(1.0, 2);
+  EXPECT_EQ(buffer.push(key(1, 0, 0), 0.0, 0), Admission::kQueued);
+  EXPECT_EQ(buffer.push(key(2, 0, 1), 0.0, 0), Admission::kQueued);
+  EXPECT_EQ(buffer.push(key(3, 0, 2), 0.0, 0), Admission::kOverflow);
+  std::vector<OrderKey> out;
+  EXPECT_EQ(buffer.releaseAll([&](const OrderKey& k, int) { out.push_back(k); }), 2u);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].stamp_ns, 1);
+}
+
+// ---- foreign input -----------------------------------------------------------------------------
+
+wavog_mapping::PlacedScan goodScan() {
+  const std::vector<float> ranges(181, 5.0f);
+  wavog::ScanView view;
+  view.ranges = ranges.data();
+  view.count = ranges.size();
+  view.angle_min = -M_PI / 2;
+  view.angle_increment = M_PI / 180;
+  view.range_min = 0.1;
+  view.range_max = 80.0;
+  wavog_mapping::PlacedScan m;
+  wavog_fleet::fillPlacedScan(ros::Time(100.0), "map", "v1", "/v1/scan", 0, wavog::Pose2{1, 2, 0.5},
+                              view, false, wavog::Pose2{1, 2, 0.5}, wavog::Pose2{1, 2, 0.5}, &m);
+  return m;
+}
+
+Refusal check(const wavog_mapping::PlacedScan& m) {
+  std::string detail;
+  const Refusal r = wavog_fleet::checkPlacedScan(m, "map", &detail);
+  EXPECT_EQ(r == Refusal::kNone, detail.empty()) << detail;
+  return r;
+}
+
+TEST(PlacedScanCheck, RefusesForeignInputByName) {
+  EXPECT_EQ(check(goodScan()), Refusal::kNone);
+  auto m = goodScan();
+  m.version = 2;  // a future writer
+  EXPECT_EQ(check(m), Refusal::kVersion);
+  m = goodScan();
+  m.header.frame_id = "odom";
+  EXPECT_EQ(check(m), Refusal::kFrame);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  m = goodScan();
+  m.x = nan;
+  EXPECT_EQ(check(m), Refusal::kBadPose);
+  m = goodScan();
+  m.theta = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(check(m), Refusal::kBadPose);
+  m = goodScan();
+  m.angle_increment = 0.0;
+  EXPECT_EQ(check(m), Refusal::kBadPose);
+  m = goodScan();
+  m.header.stamp = ros::Time();
+  EXPECT_EQ(check(m), Refusal::kBadPose);
+  m = goodScan();
+  m.ranges.clear();
+  EXPECT_EQ(check(m), Refusal::kBadSize);
+  m = goodScan();
+  m.angle_increment = 0.1;  // 181 beams over 18 rad: more than a turn
+  EXPECT_EQ(check(m), Refusal::kBadSize);
+  m = goodScan();
+  m.range_max = 0.05;  // below range_min
+  EXPECT_EQ(check(m), Refusal::kBadSize);
+  EXPECT_STREQ(wavog_fleet::toString(Refusal::kVersion), "version");
+}
+
+// ---- the merge rule ------------------------------------------------------------------------------
+
+struct Placed {
+  OrderKey key;
+  wavog_mapping::PlacedScan msg;  ///< as received (serialised and back)
+};
+
+/// Every scan of `vehicles` vehicles of a short car-park run, as their mappers would stream them.
+std::vector<Placed> fleetScans(int vehicles, double duration) {
+  std::vector<Placed> out;
+  const wavog::sim::World base = wavog::sim::defaultWorld(duration);
+  for (int k = 0; k < vehicles; ++k) {
+    const wavog::sim::World w = wavog::sim::fleetMember(base, k, vehicles);
+    wavog::sim::ScanSimulator sim(w, 11 + static_cast<std::uint64_t>(k));
+    wavog::sim::SimScan s;
+    std::uint64_t index = 0;
+    while (sim.next(&s)) {
+      const auto& laser = w.vehicle.lasers[static_cast<std::size_t>(s.laser)];
+      wavog::ScanView view = s.view(laser);
+      view.period = 1.0 / laser.rate_hz;
+      wavog_mapping::PlacedScan m;
+      const ros::Time stamp(1000.0 + s.stamp);
+      wavog_fleet::fillPlacedScan(stamp, "map", "v" + std::to_string(k), laser.topic, index,
+                                  s.sensor_pose, view, false, s.sensor_pose, s.sensor_pose, &m);
+      // Through the wire format.
+      const std::uint32_t n = ros::serialization::serializationLength(m);
+      std::vector<std::uint8_t> bytes(n);
+      ros::serialization::OStream os(bytes.data(), n);
+      ros::serialization::serialize(os, m);
+      Placed p;
+      ros::serialization::IStream is(bytes.data(), n);
+      ros::serialization::deserialize(is, p.msg);
+      p.key = OrderKey{static_cast<std::int64_t>(stamp.toNSec()), k, index++};
+      out.push_back(std::move(p));
+    }
+  }
+  return out;
+}
+
+void expectSameCells(const wavog::WaveletMap& a, const wavog::WaveletMap& b, const char* what) {
+  wavog::CellBox ba, bb;
+  ASSERT_TRUE(a.bounds(0, &ba)) << what;
+  ASSERT_TRUE(b.bounds(0, &bb)) << what;
+  ASSERT_TRUE(ba.min_x == bb.min_x && ba.min_y == bb.min_y && ba.max_x == bb.max_x &&
+              ba.max_y == bb.max_y)
+      << what;
+  const wavog::Raster ra = a.exportScale(0, ba, wavog::Aggregation::kMean);
+  const wavog::Raster rb = b.exportScale(0, bb, wavog::Aggregation::kMean);
+  ASSERT_EQ(ra.log_odds.size(), rb.log_odds.size());
+  std::size_t differ = 0, known = 0;
+  for (std::size_t i = 0; i < ra.log_odds.size(); ++i) {
+    known += ra.known[i];
+    if (ra.known[i] != rb.known[i] ||
+        std::memcmp(&ra.log_odds[i], &rb.log_odds[i], sizeof(float)) != 0) {
+      ++differ;
+    }
+  }
+  EXPECT_EQ(differ, 0u) << what << ": cells that differ of " << ra.log_odds.size();
+  EXPECT_GT(known, 10000u) << what;  // a real map, not two empty ones
+}
+
+TEST(FleetMerge, FleetMapEqualsOneMapOfAllScansInStampOrderForEveryPolicy) {
+  const std::vector<Placed> scans = fleetScans(3, 2.0);
+  ASSERT_GT(scans.size(), 900u);
+  // Arrival: each scan up to 0.25 s after its stamp, vehicles interleaved at random.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> delay(0.0, 0.25);
+  std::vector<std::pair<double, std::size_t>> arrivals;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    arrivals.push_back({scans[i].msg.header.stamp.toSec() + delay(rng), i});
+  }
+  std::sort(arrivals.begin(), arrivals.end());
+  std::vector<std::size_t> stamp_order(scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) stamp_order[i] = i;
+  std::sort(stamp_order.begin(), stamp_order.end(),
+            [&](std::size_t a, std::size_t b) { return scans[a].key < scans[b].key; });
+
+  using wavog::PolicyType;
+  struct Case {
+    PolicyType type;
+    double half_life;
+  };
+  for (const Case c : {Case{PolicyType::kNone, 0}, Case{PolicyType::kMax, 0},
+                       Case{PolicyType::kClamp, 0}, Case{PolicyType::kForget, 0},
+                       Case{PolicyType::kForget, 0.5}, Case{PolicyType::kClampLower, 0},
+                       Case{PolicyType::kClampUpper, 0}}) {
+    wavog::MapParams params = wavog::MapParams::defaultsFor(c.type);
+    params.grid.resolution = 0.1;
+    params.policy.forget_half_life = c.half_life;
+    const std::string what = std::string(wavog::toString(c.type)) +
+                             (c.half_life > 0 ? " (forget_half_life)" : "");
+
+    // The fleet node's path: checks, the reorder buffer, the decoded core call.
+    wavog::WaveletMap fleet(params);
+    ReorderBuffer<std::size_t> buffer(0.3, 100000);
+    std::size_t integrated = 0;
+    auto integrate = [&](const OrderKey&, std::size_t i) {
+      const auto& m = scans[i].msg;
+      ASSERT_EQ(wavog_fleet::checkPlacedScan(m, "map", nullptr), Refusal::kNone);
+      const wavog::IntegrateStats st =
+          fleet.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m));
+      integrated += st.status == wavog::ScanStatus::kOk;
+    };
+    for (const auto& a : arrivals) {
+      buffer.release(a.first, integrate);
+      ASSERT_EQ(buffer.push(scans[a.second].key, a.first, a.second), Admission::kQueued) << what;
+    }
+    buffer.releaseAll(integrate);
+    EXPECT_EQ(integrated, scans.size()) << what;
+
+    // One mapper fed every scan in stamp order.
+    wavog::WaveletMap single(params);
+    for (std::size_t i : stamp_order) {
+      const auto& m = scans[i].msg;
+      single.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m));
+    }
+    expectSameCells(fleet, single, what.c_str());
+  }
+}
+
+TEST(FleetMerge, OrderMattersUnderForgettingSoTheRuleIsNotVacuous) {
+  // The same scans in arrival order without the buffer: under "forget" the map differs.
+  const std::vector<Placed> scans = fleetScans(3, 1.0);
+  std::vector<std::size_t> by_vehicle(scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) by_vehicle[i] = i;  // vehicle 0's first, ...
+  std::vector<std::size_t> by_stamp = by_vehicle;
+  std::sort(by_stamp.begin(), by_stamp.end(),
+            [&](std::size_t a, std::size_t b) { return scans[a].key < scans[b].key; });
+  wavog::MapParams params = wavog::MapParams::defaultsFor(wavog::PolicyType::kForget);
+  params.grid.resolution = 0.1;
+  wavog::WaveletMap a(params), b(params);
+  for (std::size_t i : by_vehicle) a.integrate(wavog_fleet::placedPose(scans[i].msg), wavog_fleet::placedView(scans[i].msg));
+  for (std::size_t i : by_stamp) b.integrate(wavog_fleet::placedPose(scans[i].msg), wavog_fleet::placedView(scans[i].msg));
+  wavog::CellBox box;
+  ASSERT_TRUE(b.bounds(0, &box));
+  const wavog::Raster ra = a.exportScale(0, box, wavog::Aggregation::kMean);
+  const wavog::Raster rb = b.exportScale(0, box, wavog::Aggregation::kMean);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < ra.log_odds.size(); ++i) differ += ra.log_odds[i] != rb.log_odds[i];
+  EXPECT_GT(differ, 100u);
+}
+
+}  // namespace

@@ -1,0 +1,322 @@
+// A fleet over ROS (issue 30; test/fleet.test): three simulated car-park vehicles, each mapper in
+// its own process and namespace streaming the scans it integrated, one wavog_fleet node. v1 runs
+// from the start (launch), v2 is started by this test and killed (SIGKILL) at 15 s, v3 starts 20 s
+// late. Checks: the fleet map equals, cell for cell, one map fed every streamed scan in stamp
+// order; it gets at least as many ground-truth cells right as the best single vehicle; v2 is
+// stale in ~fleet_status and /diagnostics and its cells stay; v3 is caught up.
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "wavog_mapping/FleetStatus.h"
+#include "wavog_mapping/PlacedScan.h"
+#include "wavog_mapping/SaveMap.h"
+#include "wavog_mapping/core/wavelet_map.h"
+#include "wavog_mapping/ros/config.h"
+#include "wavog_mapping/sim/ground_truth.h"
+#include "wavog_mapping/sim/world.h"
+
+namespace {
+
+constexpr double kEpoch = 1.7e9;  // wavog_simulate's time 0
+constexpr double kKillAt = 15.0;  // v2 is killed (sim s)
+constexpr double kLateStart = 20.0;  // v3 starts (sim s)
+const std::vector<std::string> kVehicles = {"v1", "v2", "v3"};
+
+pid_t spawn(const std::vector<std::string>& args) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execvp(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+bool exited(pid_t pid) {
+  int status = 0;
+  return waitpid(pid, &status, WNOHANG) == pid;
+}
+
+void stop(pid_t pid) {
+  if (pid <= 0) return;
+  kill(pid, SIGINT);
+  for (int i = 0; i < 100; ++i) {
+    if (exited(pid)) return;
+    usleep(100000);
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+}
+
+/// Stops a child at the end of the test, also when an assertion returns early (a child left
+/// running would hold the test's output pipe open).
+struct Child {
+  pid_t pid = -1;
+  ~Child() { stop(pid); }
+};
+
+pid_t startMapper(const std::string& ns) {
+  return spawn({WAVOG_NODE_BIN, "__ns:=/" + ns, "__name:=wavog_mapping"});
+}
+
+struct Recorder {
+  std::mutex mutex;
+  std::vector<std::vector<wavog_mapping::PlacedScan::ConstPtr>> scans{kVehicles.size()};
+  wavog_mapping::FleetStatus::ConstPtr status;
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> diagnostics;
+};
+
+bool saveMap(const std::string& service, const std::string& path) {
+  wavog_mapping::SaveMap srv;
+  srv.request.path = path;
+  if (!ros::service::waitForService(service, ros::Duration(10.0))) return false;
+  return ros::service::call(service, srv) && srv.response.success;
+}
+
+wavog::WaveletMap loadMap(const wavog::MapParams& params, const std::string& path) {
+  wavog::WaveletMap m(params);
+  m.load(path);
+  return m;
+}
+
+/// Ground-truth cells (filled occupancy at time t) the map observed and classifies right.
+std::size_t truthCellsRight(const wavog::WaveletMap& map, const wavog::sim::World& world, double t) {
+  const auto window = wavog::sim::GridWindow::covering(world.region_min, world.region_max, 0.1);
+  const std::vector<std::uint8_t> truth = wavog::sim::occupancyAt(world, t, window);
+  std::size_t right = 0;
+  for (int row = 0; row < window.height; ++row) {
+    for (int col = 0; col < window.width; ++col) {
+      const auto c = window.centre(col, row);
+      const wavog::CellIndex cell = map.cellAt(c.x(), c.y());
+      if (!map.isObserved(cell)) continue;
+      right += (map.value(cell) > 0.0f) == (truth[window.index(col, row)] != 0);
+    }
+  }
+  return right;
+}
+
+TEST(Fleet, ThreeVehiclesOneMap) {
+  ros::NodeHandle nh;
+  Recorder rec;
+  std::vector<ros::Subscriber> subs;
+  for (std::size_t k = 0; k < kVehicles.size(); ++k) {
+    subs.push_back(nh.subscribe<wavog_mapping::PlacedScan>(
+        "/" + kVehicles[k] + "/fleet_scans", 100000,
+        [&rec, k](const wavog_mapping::PlacedScan::ConstPtr& m) {
+          std::lock_guard<std::mutex> lock(rec.mutex);
+          rec.scans[k].push_back(m);
+        }));
+  }
+  subs.push_back(nh.subscribe<wavog_mapping::FleetStatus>(
+      "/wavog_fleet/fleet_status", 10, [&rec](const wavog_mapping::FleetStatus::ConstPtr& s) {
+        std::lock_guard<std::mutex> lock(rec.mutex);
+        rec.status = s;
+      }));
+  subs.push_back(nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&rec](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
+        std::lock_guard<std::mutex> lock(rec.mutex);
+        for (const auto& s : a->status) rec.diagnostics[s.name] = s;
+      }));
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+
+  ASSERT_TRUE(ros::service::waitForService("/wavog_fleet/save_map", ros::Duration(30.0)));
+  ASSERT_TRUE(ros::service::waitForService("/v1/wavog_mapping/save_map", ros::Duration(30.0)));
+  Child v2_child, v3_child, player_child;
+  pid_t& v2 = v2_child.pid;
+  pid_t& v3 = v3_child.pid;
+  v2 = startMapper("v2");
+  ASSERT_TRUE(ros::service::waitForService("/v2/wavog_mapping/save_map", ros::Duration(30.0)));
+  ros::WallDuration(1.0).sleep();  // subscriptions connect
+  player_child.pid = spawn({"rosbag", "play", "--clock", "-q", WAVOG_FLEET_BAG});
+  const pid_t player = player_child.pid;
+  const std::string stem = "/tmp/wavog_fleet_test_" + std::to_string(getpid());
+  bool checked_stale = false, checked_late = false;
+  wavog_mapping::VehicleStatus v2_at_kill_check, v1_at_kill_check, v3_at_check;
+  std::string v2_diag_message;
+  int v2_diag_level = -1;
+  while (!exited(player)) {
+    const double t = ros::Time::now().toSec() - kEpoch;
+    if (v2 > 0 && t >= kKillAt) {
+      ASSERT_TRUE(saveMap("/v2/wavog_mapping/save_map", stem + "_v2.wmap"));
+      kill(v2, SIGKILL);
+      waitpid(v2, nullptr, 0);
+      v2 = -1;
+    }
+    if (v3 < 0 && t >= kLateStart) v3 = startMapper("v3");
+    if (!checked_stale && t >= kKillAt + 4.0) {
+      std::lock_guard<std::mutex> lock(rec.mutex);
+      if (rec.status && (rec.status->header.stamp.toSec() - kEpoch) >= kKillAt + 3.5) {
+        checked_stale = true;
+        v1_at_kill_check = rec.status->vehicles[0];
+        v2_at_kill_check = rec.status->vehicles[1];
+        for (const auto& d : rec.diagnostics) {
+          if (d.first.find("v2 vehicle") != std::string::npos) {
+            v2_diag_level = d.second.level;
+            v2_diag_message = d.second.message;
+          }
+        }
+      }
+    }
+    if (!checked_late && t >= kLateStart + 5.0) {
+      std::lock_guard<std::mutex> lock(rec.mutex);
+      if (rec.status && (rec.status->header.stamp.toSec() - kEpoch) >= kLateStart + 4.5) {
+        checked_late = true;
+        v3_at_check = rec.status->vehicles[2];
+      }
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  player_child.pid = -1;  // exited and reaped
+  // Everything streamed has passed the reorder wait (3 s) and the mappers' end-of-input flush.
+  ros::WallDuration(5.0).sleep();
+  ASSERT_TRUE(saveMap("/wavog_fleet/save_map", stem + "_fleet.wmap"));
+  ASSERT_TRUE(saveMap("/v1/wavog_mapping/save_map", stem + "_v1.wmap"));
+  ASSERT_GT(v3, 0);
+  ASSERT_TRUE(saveMap("/v3/wavog_mapping/save_map", stem + "_v3.wmap"));
+
+  // ---- v2 killed: stale, in ~fleet_status and /diagnostics; v1 streaming meanwhile.
+  ASSERT_TRUE(checked_stale);
+  EXPECT_TRUE(v2_at_kill_check.stale);
+  EXPECT_FALSE(v1_at_kill_check.stale);
+  EXPECT_EQ(v2_diag_level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(v2_diag_message.find("stale"), std::string::npos) << v2_diag_message;
+  // ---- v3, 20 s late: streaming and integrated within seconds.
+  ASSERT_TRUE(checked_late);
+  EXPECT_FALSE(v3_at_check.stale);
+  EXPECT_GT(v3_at_check.integrated, 100u);
+
+  // ---- every scan the fleet received was integrated, in order (nothing late, nothing refused).
+  wavog_mapping::FleetStatus::ConstPtr status;
+  std::vector<std::vector<wavog_mapping::PlacedScan::ConstPtr>> scans;
+  {
+    std::lock_guard<std::mutex> lock(rec.mutex);
+    status = rec.status;
+    scans = rec.scans;
+  }
+  ASSERT_TRUE(status);
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < kVehicles.size(); ++k) {
+    const auto& v = status->vehicles[k];
+    SCOPED_TRACE(kVehicles[k]);
+    EXPECT_GT(scans[k].size(), 400u);
+    EXPECT_EQ(v.received, scans[k].size());
+    EXPECT_EQ(v.integrated, scans[k].size());
+    EXPECT_EQ(v.integrated_late + v.dropped_late + v.lost + v.dropped_version + v.dropped_frame +
+                  v.dropped_bad_pose + v.dropped_bad_size + v.dropped_refused + v.dropped_overflow,
+              0u);
+    EXPECT_GT(v.bytes, scans[k].size() * 1444u);  // 361 ranges of 4 bytes each, and more
+    for (std::size_t i = 0; i < scans[k].size(); ++i) ASSERT_EQ(scans[k][i]->index, i);
+    total += scans[k].size();
+  }
+  EXPECT_EQ(status->buffered, 0u);
+
+  // ---- the merge rule: one map fed every streamed scan in stamp order (vehicle, index on ties).
+  const wavog_ros::Config config =
+      wavog_ros::loadConfigFile(std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_map.yaml", nullptr);
+  std::vector<std::tuple<ros::Time, std::size_t, std::uint64_t, const wavog_mapping::PlacedScan*>> all;
+  for (std::size_t k = 0; k < scans.size(); ++k)
+    for (const auto& m : scans[k]) all.emplace_back(m->header.stamp, k, m->index, m.get());
+  std::sort(all.begin(), all.end());
+  wavog::WaveletMap single(config.map);
+  for (const auto& e : all) {
+    const wavog_mapping::PlacedScan& m = *std::get<3>(e);
+    wavog::ScanView view;
+    view.ranges = m.ranges.data();
+    view.count = m.ranges.size();
+    view.angle_min = m.angle_min;
+    view.angle_increment = m.angle_increment;
+    view.range_min = m.range_min;
+    view.range_max = m.range_max;
+    view.period = m.period;
+    ASSERT_EQ(single.integrate(wavog::Pose2{m.x, m.y, m.theta}, view).status, wavog::ScanStatus::kOk);
+  }
+  const wavog::WaveletMap fleet = loadMap(config.map, stem + "_fleet.wmap");
+  wavog::CellBox bf, bs;
+  ASSERT_TRUE(fleet.bounds(0, &bf));
+  ASSERT_TRUE(single.bounds(0, &bs));
+  ASSERT_TRUE(bf.min_x == bs.min_x && bf.min_y == bs.min_y && bf.max_x == bs.max_x &&
+              bf.max_y == bs.max_y);
+  const wavog::Raster rf = fleet.exportScale(0, bf, wavog::Aggregation::kMean);
+  const wavog::Raster rs = single.exportScale(0, bs, wavog::Aggregation::kMean);
+  std::size_t differ = 0, known = 0;
+  for (std::size_t i = 0; i < rf.log_odds.size(); ++i) {
+    known += rf.known[i];
+    differ += rf.known[i] != rs.known[i] ||
+              std::memcmp(&rf.log_odds[i], &rs.log_odds[i], sizeof(float)) != 0;
+  }
+  EXPECT_EQ(differ, 0u) << "of " << rf.log_odds.size() << " cells (" << total << " scans)";
+  EXPECT_GT(known, 100000u);
+
+  // ---- ground truth: the fleet gets at least as many cells right as the best single vehicle.
+  const double end = 28.0;
+  const wavog::sim::World world = wavog::sim::defaultWorld(end);
+  const std::size_t fleet_right = truthCellsRight(fleet, world, end);
+  std::size_t best = 0;
+  for (const std::string v : {"v1", "v2", "v3"}) {
+    const wavog::WaveletMap m = loadMap(config.map, stem + "_" + v + ".wmap");
+    const std::size_t right = truthCellsRight(m, world, end);
+    std::printf("fleet test: %s gets %zu ground-truth cells right\n", v.c_str(), right);
+    best = std::max(best, right);
+  }
+  // ---- v2's cells stay after it was killed: every cell its stream observed (its map may hold a
+  // few scans more, integrated but still unsent when SIGKILL came) is observed in the fleet map.
+  {
+    wavog::WaveletMap streamed(config.map);
+    for (const auto& m : scans[1]) {
+      wavog::ScanView view;
+      view.ranges = m->ranges.data();
+      view.count = m->ranges.size();
+      view.angle_min = m->angle_min;
+      view.angle_increment = m->angle_increment;
+      view.range_min = m->range_min;
+      view.range_max = m->range_max;
+      view.period = m->period;
+      streamed.integrate(wavog::Pose2{m->x, m->y, m->theta}, view);
+    }
+    wavog::CellBox b;
+    ASSERT_TRUE(streamed.bounds(0, &b));
+    const wavog::Raster r = streamed.exportScale(0, b, wavog::Aggregation::kMean);
+    std::size_t observed = 0, kept = 0;
+    for (std::int64_t y = b.min_y; y < b.max_y; ++y) {
+      for (std::int64_t x = b.min_x; x < b.max_x; ++x) {
+        if (!r.known[static_cast<std::size_t>((y - b.min_y) * b.width() + (x - b.min_x))]) continue;
+        ++observed;
+        kept += fleet.isObserved(wavog::CellIndex{x, y});
+      }
+    }
+    EXPECT_GT(observed, 10000u);
+    EXPECT_EQ(kept, observed);
+  }
+  std::printf("fleet test: the fleet map gets %zu right (%zu scans)\n", fleet_right, total);
+  EXPECT_GE(fleet_right, best);
+
+  const std::string prefix = "wavog_fleet_test_" + std::to_string(getpid()) + "_";
+  for (const auto& e : std::filesystem::directory_iterator("/tmp")) {
+    if (e.path().filename().string().rfind(prefix, 0) == 0) std::filesystem::remove(e.path());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "fleet_system_test");
+  return RUN_ALL_TESTS();
+}
