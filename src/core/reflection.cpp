@@ -175,9 +175,13 @@ double hitsOf(const WaveletMap::Impl& impl, const detail::HitRatio& e,
 }
 
 // Per scale-s cell of a window, row-major: the mean hits of its cells, and under the clamps the
-// mean of what the entries' misses add to those the cells read as never hit.
+// mean of what the entries' misses add to those the cells read as never hit; at scale 0, the
+// misses of a cell with a pair (`paired`), read from it alone: `l / odd_emp + dm` would add and
+// take away the misses the cell's log-odds stands for, which at large log-odds (a loaded file)
+// swamps its counts in the float log-odds of the read-out and not in the point query's double.
 struct HitSums {
-  std::vector<double> h, dm;
+  std::vector<double> h, dm, pair_m;
+  std::vector<std::uint8_t> paired;
 };
 
 // Adds the hits of every hit cell of block `b` (origin cell x0, y0) in `window` (scale-s cells)
@@ -201,6 +205,10 @@ void addHits(const WaveletMap::Impl& impl, const Block& b, const detail::CellRun
       const detail::PairCounts now = detail::pairNow(e, l, impl.params);
       sums->h[k] += now.h;
       sums->dm[k] += now.m - impl.unhitMisses(ix, iy, l);
+      if (s == 0) {
+        sums->pair_m[k] = now.m;
+        sums->paired[k] = 1;
+      }
     } else {
       sums->h[k] += hitsOf(impl, e, &occupancy);
     }
@@ -210,7 +218,9 @@ void addHits(const WaveletMap::Impl& impl, const Block& b, const detail::CellRun
 // The hit sums of every scale-s cell of `window`, as means over its cells.
 HitSums meanHits(const WaveletMap::Impl& impl, int s, const CellBox& window) {
   const auto n = static_cast<std::size_t>(window.width() * window.height());
-  HitSums sums{std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+  HitSums sums{std::vector<double>(n, 0.0), std::vector<double>(n, 0.0),
+               std::vector<double>(s == 0 ? n : 0, 0.0),
+               std::vector<std::uint8_t>(s == 0 ? n : 0, 0)};
   const int L = impl.levels;
   const std::int64_t span = std::int64_t{1} << (L - s);  // scale-s cells per block side
   for (const auto& kv : impl.blocks) {
@@ -280,6 +290,10 @@ ReflectionRaster WaveletMap::exportReflection(int scale, const CellBox& window) 
   }
   for (std::size_t i = 0; i < r.p.size(); ++i) {
     if (known[i] == 0) continue;
+    if (!hits.paired.empty() && hits.paired[i]) {  // scale 0: a cell with a pair
+      r.p[i] = probability(hits.h[i], hits.pair_m[i]);
+      continue;
+    }
     r.p[i] = fromCounts(impl, main.log_odds[i], hits.h.empty() ? 0.0 : hits.h[i],
                         impl.misses_layer ? misses.log_odds[i] : 0.0,
                         hits.dm.empty() ? 0.0 : hits.dm[i]);
@@ -317,8 +331,7 @@ float WaveletMap::reflection(const CellIndex& cell) const {
     }
     if (const detail::HitPair* e = b->hits->pairs.find(code); e != nullptr && e->live()) {
       const detail::PairCounts now = detail::pairNow(*e, l, impl.params);
-      h = now.h;
-      dm = now.m - impl.unhitMisses(cell.x, cell.y, l);
+      return probability(now.h, now.m);  // its own misses (HitSums)
     }
   }
   return fromCounts(impl, l, h, m, dm);

@@ -144,6 +144,14 @@ struct PairCounts {
 /// Log-odds within which a hit cell reads as not updated since its pair was brought up to date
 /// (the float round-off of reading it back through the tree's details is far below).
 constexpr double kUnmoved = 1e-4;
+/// The same relative to the cell's log-odds, above the empty bound: a pair keeps its log-odds as
+/// a float e.l, set from the cell's double ones, whose round-off (half a float spacing, up to
+/// |l| 2^-24) passes half a miss (odd_emp / 2, 0.2 by default) from |l| ~ 3.4e6 and then read as
+/// misses, added again by every save and load. Up to four times that round-off a cell reads as not
+/// updated; a true miss is lost only where |l| 2^-22 > |odd_emp| (1.7e6 by default), which a
+/// clamp map reaches by updates only on the side it leaves unbounded ("clamp_lower" by millions of
+/// hits, "clamp_upper" by millions of misses), and a file anywhere up to kMaxStoredLogOdds.
+constexpr double kUnmovedRelative = 0x1p-22;
 
 /// r^k for a whole number k: by squaring where 0 <= k < 2^32, a few multiplications for the
 /// counts of misses a cell can take between its bounds (std::pow costs some hundred instructions).
@@ -169,6 +177,8 @@ inline PairCounts pairNow(const HitPair& e, double l, double odd_emp, double bou
   const double moved = l - static_cast<double>(e.l);
   if (std::fabs(moved) <= kUnmoved) return {h, m, false};  // no miss since
   if (l <= empty_bound + kAtEmptyBound) return {0.0, static_cast<float>(bound), true};
+  // Only the round-off of the float e.l at huge log-odds: no miss either.
+  if (std::fabs(moved) <= kUnmovedRelative * std::fabs(l)) return {h, m, false};
   const double n = std::max(0.0, std::round(moved / odd_emp));
   // No whole miss (float round-off of a huge e.l in a file): the counts stand, above the bound
   // too, which only the next miss scales down.

@@ -512,5 +512,111 @@ TEST(MapIo, KnowledgeTheMapCannotHoldIsRefused) {
   std::remove(path.c_str());
 }
 
+// Fuzz finding of issue 28 (fuzz_map_load): a clamp map with a reflection map (hit cells keep
+// pairs of counts) loaded from a file whose log-odds are huge (a detail of 5.44e15, within
+// kMaxStoredLogOdds): reflection(cell) read 1 and exportReflection(0, ...) 0.5 for the same cell.
+// A paired cell's misses were read as l / odd_emp plus the pair's difference to it: the terms
+// cancel in the point query's double log-odds, not with the read-out's float ones. Both now read a
+// paired cell's misses from its pair alone.
+TEST(MapIo, ReflectionPointQueryAgreesWithReadOutAtLargeLogOdds) {
+  MapParams p = MapParams::defaultsFor(wavog::PolicyType::kClamp);
+  p.grid.resolution = 0.1;
+  p.grid.block_levels = 5;
+  p.reflection = true;
+  WaveletMap source(p);
+  fill(&source, 14);
+  const std::string path = tempPath("reflection_large.wavog");
+  source.save(path);
+  auto bytes = readAll(path);
+  constexpr std::size_t kFlagsAt = 8 + 4 + 8 + 4 + 8 + 8 + 8 + 4 + 4 + 8;  // block 0's flags
+  ASSERT_TRUE(bytes[kFlagsAt] & 4) << "block 0 has no root node";
+  const float detail = 5.44e15f;  // block 0's root dy
+  std::memcpy(bytes.data() + kFlagsAt + 1 + 4, &detail, sizeof(detail));
+  bytes.resize(bytes.size() - 4);
+  const auto crc = static_cast<std::uint32_t>(
+      ::crc32(0L, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
+  const auto* c = reinterpret_cast<const char*>(&crc);
+  bytes.insert(bytes.end(), c, c + 4);
+  writeAll(path, bytes);
+  WaveletMap map(p);
+  ASSERT_NO_THROW(map.load(path));
+  wavog::CellBox box;
+  ASSERT_TRUE(map.bounds(0, &box));
+  const wavog::ReflectionRaster r = map.exportReflection(0, box);
+  std::size_t compared = 0, differ = 0;
+  for (std::int64_t y = box.min_y, i = 0; y < box.max_y; ++y) {
+    for (std::int64_t x = box.min_x; x < box.max_x; ++x, ++i) {
+      const float a = map.reflection({x, y}), b = r.p[static_cast<std::size_t>(i)];
+      if (std::isnan(a) && std::isnan(b)) continue;
+      ++compared;
+      if (!(std::fabs(a - b) <= 1e-5f)) ++differ;
+    }
+  }
+  EXPECT_GT(compared, 0u);
+  EXPECT_EQ(differ, 0u) << "of " << compared << " observed cells";
+  std::remove(path.c_str());
+}
+
+// Fuzz finding of issue 28 (fuzz_map_load_pairs_round_trip): a clamp map with a reflection map
+// loaded from a file whose details (-6.0e7, -4.3e8, within kMaxStoredLogOdds) put hit cells far
+// from their bounds (a hit cell at 7.7e7), then saved and loaded again, read other reflection
+// values. A pair keeps its cell's log-odds as a float: the loader sets it from the cell's double
+// log-odds, and each read took the difference, the float's round-off (up to 4 at 7.7e7), for up to
+// round(4 / 0.4) = 10 misses since; a save wrote them into the pair and the next load added them
+// again. Round-off of that size is no miss (pairNow, kUnmovedRelative): the read-out survives
+// round trips. Under each clamp policy: "clamp_lower" (no upper bound) and "clamp_upper" (no
+// lower one) reach such log-odds by updates too, on their unbounded side, so that a loader bound
+// would not do for them.
+TEST(MapIo, ReflectionPairsSurviveARoundTripAtLargeLogOdds) {
+  const std::string path = tempPath("reflection_pairs.wavog");
+  for (auto policy : {wavog::PolicyType::kClamp, wavog::PolicyType::kClampLower,
+                      wavog::PolicyType::kClampUpper}) {
+    // Block 0's cells at ~ +-7.7e7 (a float's spacing there: 8) and at eight offsets, so that
+    // some hit cells' log-odds round to a float above them, some below.
+    for (int k = -8; k < 8; ++k) {
+      const double average = k < 0 ? -7.7e7 + k : 7.7e7 + k;
+      SCOPED_TRACE(std::to_string(static_cast<int>(policy)) + " " + std::to_string(average));
+      MapParams p = MapParams::defaultsFor(policy);
+      p.grid.resolution = 0.1;
+      p.grid.block_levels = 5;
+      p.reflection = true;
+      WaveletMap source(p);
+      fill(&source, 14);
+      source.save(path);
+      auto bytes = readAll(path);
+      constexpr std::size_t kAverageAt = 8 + 4 + 8 + 4 + 8 + 8 + 8 + 4 + 4;  // block 0's average
+      std::memcpy(bytes.data() + kAverageAt, &average, sizeof(average));
+      bytes.resize(bytes.size() - 4);
+      const auto crc = static_cast<std::uint32_t>(::crc32(
+          0L, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
+      const auto* c = reinterpret_cast<const char*>(&crc);
+      bytes.insert(bytes.end(), c, c + 4);
+      writeAll(path, bytes);
+      WaveletMap map(p);
+      ASSERT_NO_THROW(map.load(path));
+      wavog::CellBox box;
+      ASSERT_TRUE(map.bounds(0, &box));
+      const wavog::ReflectionRaster first = map.exportReflection(0, box);
+      for (int trip = 1; trip <= 2; ++trip) {
+        map.save(path);
+        WaveletMap again(p);
+        ASSERT_NO_THROW(again.load(path));
+        const wavog::ReflectionRaster r = again.exportReflection(0, box);
+        ASSERT_EQ(r.p.size(), first.p.size());
+        std::size_t compared = 0, differ = 0;
+        for (std::size_t i = 0; i < r.p.size(); ++i) {
+          if (std::isnan(first.p[i]) && std::isnan(r.p[i])) continue;
+          ++compared;
+          if (std::memcmp(&first.p[i], &r.p[i], sizeof(float)) != 0) ++differ;
+        }
+        EXPECT_GT(compared, 0u);
+        EXPECT_EQ(differ, 0u) << "of " << compared << " observed cells, round trip " << trip;
+        map.load(path);
+      }
+    }
+  }
+  std::remove(path.c_str());
+}
+
 }  // namespace
 }  // namespace wavog_test

@@ -46,8 +46,11 @@ inline void writeFile(const std::string& path, const std::uint8_t* data, std::si
 }
 
 inline std::vector<char> readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::vector<char> out(in ? static_cast<std::size_t>(in.tellg()) : 0);
+  in.seekg(0);
+  in.read(out.data(), static_cast<std::streamsize>(out.size()));
+  return out;
 }
 
 /// An oracle violation: prints and aborts, so libFuzzer records the input as a crash.
@@ -61,9 +64,10 @@ inline std::vector<char> readFile(const std::string& path) {
     }                                                                                   \
   } while (0)
 
-/// Cells a harness reads out of one window at most (2^18: 1 MiB of floats; larger windows would
-/// mostly cost instrumented fill loops). A harness speed choice, not a core limit.
-constexpr std::int64_t kReadOutCells = std::int64_t{1} << 18;
+/// Cells a harness reads out of one window at most (2^12, 64 x 64: larger windows mostly cost
+/// instrumented fill loops; at 2^18 a 1 cm map with 4096-cell blocks took 2 s per input, reading
+/// out six scales three times). A harness speed choice, not a core limit.
+constexpr std::int64_t kReadOutCells = std::int64_t{1} << 12;
 
 /// The window a harness reads out of `bounds` (which the core accepts, readoutFits): the bounds,
 /// or their lower corner when they hold more than kReadOutCells cells.
@@ -71,7 +75,7 @@ inline wavog::CellBox readOutWindow(const wavog::CellBox& bounds) {
   wavog::CellBox w = bounds;
   if (static_cast<double>(w.width()) * static_cast<double>(w.height()) >
       static_cast<double>(kReadOutCells)) {
-    w.max_x = w.min_x + std::min<std::int64_t>(w.width(), 512);
+    w.max_x = w.min_x + std::min<std::int64_t>(w.width(), 64);
     w.max_y = w.min_y + std::min<std::int64_t>(w.height(), kReadOutCells / (w.max_x - w.min_x));
   }
   return w;
@@ -101,12 +105,12 @@ inline bool sameBits(const wavog::Raster& a, const wavog::Raster& b) {
 
 /// Cells of a scale-0 window whose point queries (value, reflection, ndtCell) a harness compares
 /// with the window's read-out: at most this many, from its lower corner (a speed choice).
-constexpr std::int64_t kPointQueries = 4096;
+constexpr std::int64_t kPointQueries = 1024;
 
 /// The lower-corner window of at most kPointQueries cells of a scale-0 window `box`.
 inline wavog::CellBox pointQueryWindow(const wavog::CellBox& box) {
   wavog::CellBox q = box;
-  q.max_x = q.min_x + std::min<std::int64_t>(q.width(), 64);
+  q.max_x = q.min_x + std::min<std::int64_t>(q.width(), 32);
   q.max_y = q.min_y + std::min<std::int64_t>(q.height(), kPointQueries / (q.max_x - q.min_x));
   return q;
 }
