@@ -127,6 +127,14 @@ void readHitRuns(std::uint32_t n, int levels, CellRuns<Entry>* runs, Reader* r) 
   runs->sorted = n;
 }
 
+// The reflection mode "prior" (h + m = 1, h from the occupancy alone) is that of "forget" with
+// the empty_bound prior only (Impl::restartReflection; a file's older layers load as "layers"
+// under any policy). A file claiming it under another policy read differently by each path: the
+// read-out derived a clamp map's hits from its occupancy, the point query read a cell's pair.
+bool modeOfPolicy(ReflectionMode m, PolicyType t) {
+  return m != ReflectionMode::kPrior || t == PolicyType::kForget;
+}
+
 }  // namespace
 
 double payloadSectionsBound(std::uint32_t version, std::uint64_t blocks, int levels) {
@@ -232,6 +240,10 @@ FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::uint32_t 
   }
   f.mode = static_cast<ReflectionMode>(mode);
   f.basis.type = static_cast<PolicyType>(type);
+  if (!modeOfPolicy(f.mode, f.basis.type)) {
+    throw std::runtime_error("reflection mode " + std::to_string(mode) + " (prior) under policy " +
+                             toString(f.basis.type) + ": only forget keeps it");
+  }
   f.basis.odd_occ = r->get<double>();
   f.basis.odd_emp = r->get<double>();
   f.basis.init = r->get<double>();

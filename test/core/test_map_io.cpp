@@ -618,5 +618,62 @@ TEST(MapIo, ReflectionPairsSurviveARoundTripAtLargeLogOdds) {
   std::remove(path.c_str());
 }
 
+
+// Fuzz finding of issue 28 (fuzz_map_load): the seed finding_i28_pairs_round_trip with its
+// reflection mode byte 1 (derived) turned to 2 ("prior", h + m = 1 from the occupancy alone, which
+// only "forget" with the empty_bound prior keeps) loaded into a clamp map, and reflection(-6, -5)
+// read 0.667 (the cell's pair) where the read-out read 1 (the occupancy). Such a file is refused;
+// "prior" under "forget" still loads.
+TEST(MapIo, ReflectionModeThePolicyNeverKeepsIsRefused) {
+  const auto seed = readAll(std::string(WAVOG_SOURCE_DIR) +
+                            "/test/fuzz/corpus/fuzz_map_load/finding_i28_pairs_round_trip");
+  ASSERT_GT(seed.size(), 1968u);
+  // fuzz_map_load's framing (mode byte 0x81: framed version 5, clamp, reflection).
+  const auto frame = [](std::vector<char> body) {
+    std::vector<char> out = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
+    const std::uint32_t version = 5;
+    const auto* v = reinterpret_cast<const char*>(&version);
+    out.insert(out.end(), v, v + sizeof(version));
+    out.insert(out.end(), body.begin() + 1, body.end());
+    const auto crc = static_cast<std::uint32_t>(
+        ::crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
+    const auto* c = reinterpret_cast<const char*>(&crc);
+    out.insert(out.end(), c, c + sizeof(crc));
+    return out;
+  };
+  MapParams p = MapParams::defaultsFor(wavog::PolicyType::kClamp);
+  p.grid.resolution = 0.2;
+  p.grid.block_levels = 4;
+  p.reflection = true;
+  const std::string path = tempPath("reflection_mode.wavog");
+  constexpr std::size_t kModeAt = 1967;  // the reflection mode byte in the seed (1: derived)
+  ASSERT_EQ(seed[kModeAt], 1);
+  writeAll(path, frame(seed));
+  {
+    WaveletMap map(p);
+    ASSERT_NO_THROW(map.load(path));
+  }
+  auto prior = seed;
+  prior[kModeAt] = 2;
+  writeAll(path, frame(prior));
+  WaveletMap map(p);
+  const std::string why = refusal(&map, path);
+  EXPECT_NE(why.find("only forget keeps it"), std::string::npos) << why;
+  EXPECT_EQ(map.stats().blocks, 0u);
+  if (why.empty()) {  // before the fix: loaded, and the point query and read-out disagreed
+    const wavog::CellBox box{-6, -5, -5, -4};
+    EXPECT_NEAR(map.reflection({-6, -5}), map.exportReflection(0, box).p[0], 1e-5f);
+  }
+  // "prior" under "forget" (an empty map of that mode) loads.
+  MapParams f = MapParams::defaultsFor(wavog::PolicyType::kForget);
+  f.policy.init = wavog::InitValue::kEmptyBound;
+  f.reflection = true;
+  WaveletMap forget(f);
+  forget.save(path);
+  WaveletMap back(f);
+  EXPECT_NO_THROW(back.load(path));
+  std::remove(path.c_str());
+}
+
 }  // namespace
 }  // namespace wavog_test
