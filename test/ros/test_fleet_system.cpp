@@ -80,6 +80,8 @@ struct Recorder {
   std::vector<std::vector<wavog_mapping::PlacedScan::ConstPtr>> scans{kVehicles.size()};
   wavog_mapping::FleetStatus::ConstPtr status;
   std::map<std::string, diagnostic_msgs::DiagnosticStatus> diagnostics;
+  std::vector<double> lag_max = std::vector<double>(kVehicles.size(), 0.0);  ///< over the run
+  std::vector<double> publish_lag_max = std::vector<double>(kVehicles.size(), 0.0);
 };
 
 bool saveMap(const std::string& service, const std::string& path) {
@@ -127,6 +129,10 @@ TEST(Fleet, ThreeVehiclesOneMap) {
       "/wavog_fleet/fleet_status", 10, [&rec](const wavog_mapping::FleetStatus::ConstPtr& s) {
         std::lock_guard<std::mutex> lock(rec.mutex);
         rec.status = s;
+        for (std::size_t k = 0; k < s->vehicles.size() && k < kVehicles.size(); ++k) {
+          rec.lag_max[k] = std::max(rec.lag_max[k], s->vehicles[k].lag_max);
+          rec.publish_lag_max[k] = std::max(rec.publish_lag_max[k], s->vehicles[k].publish_lag_max);
+        }
       }));
   subs.push_back(nh.subscribe<diagnostic_msgs::DiagnosticArray>(
       "/diagnostics", 100, [&rec](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
@@ -205,10 +211,13 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   // ---- every scan the fleet received was integrated, in order (nothing late, nothing refused).
   wavog_mapping::FleetStatus::ConstPtr status;
   std::vector<std::vector<wavog_mapping::PlacedScan::ConstPtr>> scans;
+  std::vector<double> lag_max, publish_lag_max;
   {
     std::lock_guard<std::mutex> lock(rec.mutex);
     status = rec.status;
     scans = rec.scans;
+    lag_max = rec.lag_max;
+    publish_lag_max = rec.publish_lag_max;
   }
   ASSERT_TRUE(status);
   std::size_t total = 0;
@@ -224,6 +233,11 @@ TEST(Fleet, ThreeVehiclesOneMap) {
     EXPECT_GT(v.bytes, scans[k].size() * 1444u);  // 361 ranges of 4 bytes each, and more
     for (std::size_t i = 0; i < scans[k].size(); ++i) ASSERT_EQ(scans[k][i]->index, i);
     total += scans[k].size();
+    // A scan reaches the published layers after its integration: the largest lag to the layers'
+    // publication is at least the largest lag to integration (every scan was published: save_map
+    // publishes), and both include the reorder wait (3 wall s, fleet_map.yaml).
+    EXPECT_GE(lag_max[k], 2.9);  // sim time, /clock at 100 Hz
+    EXPECT_GE(publish_lag_max[k], lag_max[k]);
   }
   EXPECT_EQ(status->buffered, 0u);
 
