@@ -1,8 +1,9 @@
 # `make fleet-demo` (issue 30): three simulated vehicles, each mapper in its own process and
 # namespace streaming its placed scans, one wavog_fleet node, over a private roscore. Writes
 # FLEET_OUT: the fleet map and each vehicle's map (native + images), fleet_vs_vehicles.png,
-# report.md / report.json (bandwidth per vehicle: stream vs OccupancyGrid layers vs LaserScans;
-# fleet CPU per vehicle-second; lag). Needs no data file. About a minute after the build.
+# report.md / report.json (bandwidth per vehicle: stream vs changed Haar blocks (design b, one
+# more playback) vs OccupancyGrid layers vs LaserScans;
+# fleet CPU per vehicle-second; lag). Needs no data file. About 80 s after the build.
 FLEET_OUT ?= $(ROOT)/fleet_output
 FLEET_DURATION ?= 30
 # FLEET_BENCH=1: also run the 8-vehicle bench (fleet-bench below) into FLEET_OUT/bench and append
