@@ -3,9 +3,12 @@
 // from the start (launch), v2 is started by this test and killed (SIGKILL) at 15 s, v3 starts 20 s
 // late. Checks: the fleet map equals, cell for cell, one map fed every streamed scan in stamp
 // order; it gets at least as many ground-truth cells right as the best single vehicle; v2 is
-// stale in ~fleet_status and /diagnostics and its cells stay; v3 is caught up.
+// stale in ~fleet_status and /diagnostics and its cells stay; v3 is caught up. Each process has
+// its own loopback address (fleet.test), as on distinct hosts: checked at the master.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
+#include <ros/master.h>
+#include <ros/network.h>
 #include <ros/ros.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -36,9 +39,22 @@ constexpr double kKillAt = 15.0;  // v2 is killed (sim s)
 constexpr double kLateStart = 20.0;  // v3 starts (sim s)
 const std::vector<std::string> kVehicles = {"v1", "v2", "v3"};
 
-pid_t spawn(const std::vector<std::string>& args) {
+/// The loopback address each process of the test has (test/fleet.test), as hosts would.
+const std::map<std::string, std::string> kHosts = {{"/wavog_fleet", "127.0.0.2"},
+                                                   {"/v1/wavog_mapping", "127.0.0.3"},
+                                                   {"/v2/wavog_mapping", "127.0.0.4"},
+                                                   {"/v3/wavog_mapping", "127.0.0.5"}};
+constexpr const char* kTestHost = "127.0.0.6";
+
+/// Starts `args`; `host` non-empty: the child's ROS_HOSTNAME (and no ROS_IP: roscpp listens on
+/// 127.0.0.1 only when ROS_IP is 127.*).
+pid_t spawn(const std::vector<std::string>& args, const std::string& host = "") {
   const pid_t pid = fork();
   if (pid == 0) {
+    if (!host.empty()) {
+      unsetenv("ROS_IP");
+      setenv("ROS_HOSTNAME", host.c_str(), 1);
+    }
     std::vector<char*> argv;
     for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
@@ -72,7 +88,26 @@ struct Child {
 };
 
 pid_t startMapper(const std::string& ns) {
-  return spawn({WAVOG_NODE_BIN, "__ns:=/" + ns, "__name:=wavog_mapping"});
+  return spawn({WAVOG_NODE_BIN, "__ns:=/" + ns, "__name:=wavog_mapping"},
+               kHosts.at("/" + ns + "/wavog_mapping"));
+}
+
+/// The host of `node`'s XML-RPC URI as the master has it (where its peers connect); empty when
+/// the master does not know the node.
+std::string nodeHost(const std::string& node) {
+  XmlRpc::XmlRpcValue args, result, payload;
+  args[0] = ros::this_node::getName();
+  args[1] = node;
+  if (!ros::master::execute("lookupNode", args, result, payload, false)) return "";
+  if (result.getType() != XmlRpc::XmlRpcValue::TypeArray || result.size() < 3 ||
+      static_cast<int>(result[0]) != 1) {
+    return "";
+  }
+  std::string uri = result[2];  // http://host:port/
+  const auto begin = uri.find("://");
+  if (begin == std::string::npos) return "";
+  uri = uri.substr(begin + 3);
+  return uri.substr(0, uri.find(':'));
 }
 
 struct Recorder {
@@ -149,6 +184,11 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   pid_t& v3 = v3_child.pid;
   v2 = startMapper("v2");
   ASSERT_TRUE(ros::service::waitForService("/v2/wavog_mapping/save_map", ros::Duration(30.0)));
+  // Each process is reached at its own address (fleet.test), as on another machine.
+  EXPECT_EQ(ros::network::getHost(), kTestHost);
+  for (const char* node : {"/wavog_fleet", "/v1/wavog_mapping", "/v2/wavog_mapping"}) {
+    EXPECT_EQ(nodeHost(node), kHosts.at(node)) << node;
+  }
   ros::WallDuration(1.0).sleep();  // subscriptions connect
   player_child.pid = spawn({"rosbag", "play", "--clock", "-q", WAVOG_FLEET_BAG});
   const pid_t player = player_child.pid;
@@ -195,6 +235,7 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   ASSERT_TRUE(saveMap("/wavog_fleet/save_map", stem + "_fleet.wmap"));
   ASSERT_TRUE(saveMap("/v1/wavog_mapping/save_map", stem + "_v1.wmap"));
   ASSERT_GT(v3, 0);
+  EXPECT_EQ(nodeHost("/v3/wavog_mapping"), kHosts.at("/v3/wavog_mapping"));
   ASSERT_TRUE(saveMap("/v3/wavog_mapping/save_map", stem + "_v3.wmap"));
 
   // ---- v2 killed: stale, in ~fleet_status and /diagnostics; v1 streaming meanwhile.
