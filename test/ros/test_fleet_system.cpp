@@ -4,7 +4,8 @@
 // late. Checks: the fleet map equals, cell for cell, one map fed every streamed scan in stamp
 // order; it gets at least as many ground-truth cells right as the best single vehicle; v2 is
 // stale in ~fleet_status and /diagnostics and its cells stay; v3 is caught up. Each process has
-// its own loopback address (fleet.test), as on distinct hosts: checked at the master.
+// its own loopback address (fleet.test), as on distinct hosts: checked at the master. A fleet
+// node started after the run from the first one's save_map (map_file) holds that map exactly.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <ros/master.h>
@@ -318,6 +319,33 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   }
   EXPECT_EQ(differ, 0u) << "of " << rf.log_odds.size() << " cells (" << total << " scans)";
   EXPECT_GT(known, 100000u);
+
+  // ---- a fleet node started late catches up from map_file, the other fleet node's save_map: its
+  // map is that map, cell for cell, before any scan reaches it.
+  {
+    Child loader, late;
+    loader.pid = spawn({"rosparam", "load", std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_map.yaml",
+                        "/late/wavog_fleet"});
+    int status_code = -1;
+    ASSERT_EQ(waitpid(loader.pid, &status_code, 0), loader.pid);
+    loader.pid = -1;
+    ASSERT_TRUE(WIFEXITED(status_code) && WEXITSTATUS(status_code) == 0);
+    ros::param::set("/late/wavog_fleet/map_file", stem + "_fleet.wmap");
+    late.pid = spawn({WAVOG_FLEET_BIN, "__ns:=/late", "__name:=wavog_fleet"});
+    ASSERT_TRUE(saveMap("/late/wavog_fleet/save_map", stem + "_late.wmap"));
+  }
+  const wavog::WaveletMap caught = loadMap(config.map, stem + "_late.wmap");
+  wavog::CellBox bl;
+  ASSERT_TRUE(caught.bounds(0, &bl));
+  ASSERT_TRUE(bl.min_x == bf.min_x && bl.min_y == bf.min_y && bl.max_x == bf.max_x &&
+              bl.max_y == bf.max_y);
+  const wavog::Raster rl = caught.exportScale(0, bl, wavog::Aggregation::kMean);
+  std::size_t differ_late = 0;
+  for (std::size_t i = 0; i < rf.log_odds.size(); ++i) {
+    differ_late += rf.known[i] != rl.known[i] ||
+                   std::memcmp(&rf.log_odds[i], &rl.log_odds[i], sizeof(float)) != 0;
+  }
+  EXPECT_EQ(differ_late, 0u) << "of " << rf.log_odds.size() << " cells";
 
   // ---- ground truth: the fleet gets at least as many cells right as the best single vehicle.
   const double end = 28.0;
