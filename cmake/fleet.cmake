@@ -49,7 +49,8 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node
                         ${GTEST_LIBRARIES})
   target_compile_definitions(test_fleet_system PRIVATE
     WAVOG_FLEET_BAG="${WAVOG_FLEET_BAG}" WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
-    WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node")
+    WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node"
+    WAVOG_FLEET_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_fleet")
   add_dependencies(test_fleet_system ${PROJECT_NAME}_generate_messages_cpp wavog_mapping_node
                    wavog_fleet wavog_fleet_nodelet wavog_fleet_test_bag)
 endif()

@@ -4,9 +4,10 @@ namespace streaming its placed scans (fleet_stream), one wavog_fleet node, over 
 
 Writes into OUT: fleet3.bag (wavog_simulate --vehicles 3), fleet.* and v<k>.* (the maps saved by
 ~save_map: native map + map_server images), fleet_vs_vehicles.png (side by side), report.md and
-report.json with the bandwidth per vehicle (the stream, the vehicle's OccupancyGrid layers and
-map_updates as published, its raw LaserScans), the fleet node's CPU per vehicle-second and the lag
-from a scan's stamp to the fleet map (integration; the layers follow at publish_rate).
+report.json with the bandwidth per vehicle (the stream, design (b)'s changed Haar blocks measured
+by fleet_design_b.py in a second playback, the vehicle's OccupancyGrid layers and map_updates as
+published, its raw LaserScans), the fleet node's CPU per vehicle-second and the lag from a scan's
+stamp to the fleet map (integration, and the layers' publication).
 
 usage: fleet_demo.py BIN_DIR SOURCE_DIR OUT [DURATION]
 """
@@ -14,6 +15,7 @@ import json
 import os
 import signal
 import socket
+import struct
 import subprocess
 import sys
 import time
@@ -41,7 +43,7 @@ def cpu_seconds(pid):
 def main():
     os.makedirs(OUT, exist_ok=True)
     bag = os.path.join(OUT, "fleet3.bag")
-    print("fleet-demo: [1/4] simulating 3 vehicles in the car park, %.0f s" % DURATION, flush=True)
+    print("fleet-demo: [1/5] simulating 3 vehicles in the car park, %.0f s" % DURATION, flush=True)
     subprocess.run([os.path.join(BIN, "wavog_simulate"), "--vehicles", "3", "--duration",
                     str(DURATION), "--seed", "1", "--out", bag], check=True,
                    stderr=subprocess.DEVNULL)
@@ -104,6 +106,7 @@ def main():
                 subs.append(counter("/%s/%s" % (v, t)))
         lags = []
         lag_maxes = []
+        publish_lag_maxes = []
         last = {}
 
         def on_status(s):
@@ -112,19 +115,21 @@ def main():
                 if v.integrated > 0 and not v.stale:
                     lags.append(v.lag)
                     lag_maxes.append(v.lag_max)
+                    if v.publish_lag_max > 0:
+                        publish_lag_maxes.append(v.publish_lag_max)
         subs.append(rospy.Subscriber("/wavog_fleet/fleet_status", FleetStatus, on_status))
         for v in VEHICLES:
             rospy.wait_for_service("/%s/wavog_mapping/save_map" % v, timeout=30)
         rospy.wait_for_service("/wavog_fleet/save_map", timeout=30)
         time.sleep(1.0)
-        print("fleet-demo: [2/4] playing it: 3 mappers streaming, one fleet node", flush=True)
+        print("fleet-demo: [2/5] playing it: 3 mappers streaming, one fleet node", flush=True)
         cpu0 = cpu_seconds(fleet.pid)
         wall0 = time.time()
         subprocess.run(["rosbag", "play", "--clock", "-q", bag], env=env, check=True)
         wall = time.time() - wall0
         time.sleep(4.0)
         cpu = cpu_seconds(fleet.pid) - cpu0
-        print("fleet-demo: [3/4] saving the maps", flush=True)
+        print("fleet-demo: [3/5] saving the maps", flush=True)
         from wavog_mapping.srv import SaveMap
         for name, service in [("fleet", "/wavog_fleet/save_map")] + [
                 (v, "/%s/wavog_mapping/save_map" % v) for v in VEHICLES]:
@@ -141,7 +146,16 @@ def main():
             except subprocess.TimeoutExpired:
                 p.kill()
 
-    print("fleet-demo: [4/4] figure and report", flush=True)
+    print("fleet-demo: [4/5] design (b) measured: each vehicle's changed map blocks every 0.5 s "
+          "(one more playback)", flush=True)
+    subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts/fleet_design_b.py"), BIN, SRC,
+                    OUT, bag, ",".join(VEHICLES), "0.5"], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    with open(os.path.join(OUT, "design_b.json")) as f:
+        design_b = {d["vehicle"]: d for d in json.load(f)}
+    with open(os.path.join(OUT, VEHICLES[0] + ".wavog"), "rb") as f:
+        block_side = 2 ** struct.unpack_from("<i", f.read(24), 20)[0]  # the header's block_levels
+    print("fleet-demo: [5/5] figure and report", flush=True)
     rows = []
     for v in VEHICLES:
         def rate(topics):
@@ -149,7 +163,10 @@ def main():
         stream = rate(["fleet_scans"])
         layers = rate(["map", "map_scale_2", "map_scale_3", "map_scale_4", "map_updates"])
         scans = rate(["scan_front_left", "scan_front_right", "scan_rear_left", "scan_rear_right"])
-        rows.append({"vehicle": v, "stream_Bps": stream, "layers_Bps": layers, "laserscans_Bps": scans})
+        rows.append({"vehicle": v, "stream_Bps": stream, "layers_Bps": layers, "laserscans_Bps": scans,
+                     "haar_blocks_Bps": design_b[v]["bytes_per_s"],
+                     "haar_blocks_changed_per_period": design_b[v]["changed_blocks_per_period"],
+                     "haar_blocks_final": design_b[v]["final_blocks"]})
     vs = status.vehicles
     integrated = sum(v.integrated for v in vs)
     lags_sorted = sorted(lags)
@@ -162,6 +179,9 @@ def main():
                        + v.dropped_refused + v.dropped_overflow for v in vs),
         "lag_median_s": lags_sorted[len(lags_sorted) // 2] if lags else None,
         "lag_max_s": max(lag_maxes) if lag_maxes else None,
+        "publish_lag_period_max_median_s": (sorted(publish_lag_maxes)[len(publish_lag_maxes) // 2]
+                                            if publish_lag_maxes else None),
+        "publish_lag_max_s": max(publish_lag_maxes) if publish_lag_maxes else None,
         "publish_rate_hz": 2.0,
         "reorder_wait_s": status.reorder_wait,
     }
@@ -207,23 +227,39 @@ def main():
              "its own process and namespace, one wavog_fleet (config/fleet.yaml), one roscore, "
              "measured in one run (wall %.1f s on this machine)." % (DURATION, wall), "",
              "## Bandwidth per vehicle (bytes/s, serialized, as received over TCPROS)", "",
-             "| vehicle | placed-scan stream (chosen) | OccupancyGrid layers + map_updates | raw LaserScans | stream / layers |",
-             "|---|---:|---:|---:|---:|"]
+             "| vehicle | (a) placed-scan stream (chosen) | (b) changed Haar blocks every 0.5 s | OccupancyGrid layers + map_updates | raw LaserScans | (a) / layers | (b) / layers |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        lines.append("| %s | %.0f | %.0f | %.0f | %.2f |" % (
-            r["vehicle"], r["stream_Bps"], r["layers_Bps"], r["laserscans_Bps"],
-            r["stream_Bps"] / r["layers_Bps"] if r["layers_Bps"] else float("nan")))
+        lines.append("| %s | %.0f | %.0f | %.0f | %.0f | %.2f | %.2f |" % (
+            r["vehicle"], r["stream_Bps"], r["haar_blocks_Bps"], r["layers_Bps"],
+            r["laserscans_Bps"],
+            r["stream_Bps"] / r["layers_Bps"] if r["layers_Bps"] else float("nan"),
+            r["haar_blocks_Bps"] / r["layers_Bps"] if r["layers_Bps"] else float("nan")))
     lines += ["",
               "Layers: the mapper's map, map_scale_2/3/4 at publish_rate 2 Hz and map_updates at "
               "5 Hz, as config/lms291_x4.yaml publishes them (whole map, publish_window 0).", "",
+              "(b): the same bag mapped again by the same mappers (scripts/fleet_design_b.py), "
+              "each saved every 0.5 s of sim time; per period, the blocks new or changed since the "
+              "previous save, in the native file's block encoding (coordinates, average, flags, "
+              "coefficient subtree), plus 8 bytes per removed block, summed over the run / its "
+              "length; no message framing. A block here is %d x %d cells at 0.1 m; each vehicle's "
+              "map ends with %s blocks, and %s of them changed per period on average, so (b) "
+              "resends most of the observed map every period." % (
+                  block_side, block_side, "/".join(str(r["haar_blocks_final"]) for r in rows),
+                  "/".join("%.1f" % r["haar_blocks_changed_per_period"] for r in rows)), "",
               "## Fleet node", "",
               "- scans integrated: %d; late: %d; refused: %d" % (integrated, report["late"], report["refused"]),
               "- CPU: %.2f s for %d vehicle-seconds = %.4f s per vehicle-second (%.1f %% of a core per vehicle)" % (
                   cpu, len(VEHICLES) * DURATION, report["fleet_cpu_per_vehicle_second"],
                   100 * report["fleet_cpu_per_vehicle_second"]),
               "- lag from a scan's stamp to its integration into the fleet map (sampled at each ~fleet_status): median %.3f s, max %.3f s "
-              "(fleet_reorder_wait %.1f s dominates; the layers are published every 1 / publish_rate "
-              "= 0.5 s after that)" % (report["lag_median_s"] or 0, report["lag_max_s"] or 0, status.reorder_wait),
+              "(fleet_reorder_wait %.1f s dominates)" % (
+                  report["lag_median_s"] or 0, report["lag_max_s"] or 0, status.reorder_wait),
+              "- lag from a scan's stamp to the first publication of the fleet map's layers that "
+              "include it (VehicleStatus.publish_lag_max, the largest per publish period): median "
+              "over periods %.3f s, max %.3f s (the integration lag plus up to 1 / publish_rate = "
+              "%.1f s)" % (report["publish_lag_period_max_median_s"] or 0,
+                           report["publish_lag_max_s"] or 0, 1.0 / report["publish_rate_hz"]),
               "", "Figure: fleet_vs_vehicles.png (fleet map, then each vehicle's own map)."]
     with open(os.path.join(OUT, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")

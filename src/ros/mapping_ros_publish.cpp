@@ -44,6 +44,7 @@ void MappingRos::Impl::publishAll() {
     if (window_ok) {
       layers = publisher_->read(map_, rp, cx, cy);
       changed_since_publish_ = false;
+      if (fleet_ && layers.refused.empty()) fleet_->layersPublishedLocked(now);
     }
     layers_refused_ += layers.refused.size();
     status = statusLocked(now);

@@ -3,9 +3,13 @@
 // from the start (launch), v2 is started by this test and killed (SIGKILL) at 15 s, v3 starts 20 s
 // late. Checks: the fleet map equals, cell for cell, one map fed every streamed scan in stamp
 // order; it gets at least as many ground-truth cells right as the best single vehicle; v2 is
-// stale in ~fleet_status and /diagnostics and its cells stay; v3 is caught up.
+// stale in ~fleet_status and /diagnostics and its cells stay; v3 is caught up. Each process has
+// its own loopback address (fleet.test), as on distinct hosts: checked at the master. A fleet
+// node started after the run from the first one's save_map (map_file) holds that map exactly.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
+#include <ros/master.h>
+#include <ros/network.h>
 #include <ros/ros.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -36,9 +40,22 @@ constexpr double kKillAt = 15.0;  // v2 is killed (sim s)
 constexpr double kLateStart = 20.0;  // v3 starts (sim s)
 const std::vector<std::string> kVehicles = {"v1", "v2", "v3"};
 
-pid_t spawn(const std::vector<std::string>& args) {
+/// The loopback address each process of the test has (test/fleet.test), as hosts would.
+const std::map<std::string, std::string> kHosts = {{"/wavog_fleet", "127.0.0.2"},
+                                                   {"/v1/wavog_mapping", "127.0.0.3"},
+                                                   {"/v2/wavog_mapping", "127.0.0.4"},
+                                                   {"/v3/wavog_mapping", "127.0.0.5"}};
+constexpr const char* kTestHost = "127.0.0.6";
+
+/// Starts `args`; `host` non-empty: the child's ROS_HOSTNAME (and no ROS_IP: roscpp listens on
+/// 127.0.0.1 only when ROS_IP is 127.*).
+pid_t spawn(const std::vector<std::string>& args, const std::string& host = "") {
   const pid_t pid = fork();
   if (pid == 0) {
+    if (!host.empty()) {
+      unsetenv("ROS_IP");
+      setenv("ROS_HOSTNAME", host.c_str(), 1);
+    }
     std::vector<char*> argv;
     for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
@@ -72,7 +89,26 @@ struct Child {
 };
 
 pid_t startMapper(const std::string& ns) {
-  return spawn({WAVOG_NODE_BIN, "__ns:=/" + ns, "__name:=wavog_mapping"});
+  return spawn({WAVOG_NODE_BIN, "__ns:=/" + ns, "__name:=wavog_mapping"},
+               kHosts.at("/" + ns + "/wavog_mapping"));
+}
+
+/// The host of `node`'s XML-RPC URI as the master has it (where its peers connect); empty when
+/// the master does not know the node.
+std::string nodeHost(const std::string& node) {
+  XmlRpc::XmlRpcValue args, result, payload;
+  args[0] = ros::this_node::getName();
+  args[1] = node;
+  if (!ros::master::execute("lookupNode", args, result, payload, false)) return "";
+  if (result.getType() != XmlRpc::XmlRpcValue::TypeArray || result.size() < 3 ||
+      static_cast<int>(result[0]) != 1) {
+    return "";
+  }
+  std::string uri = result[2];  // http://host:port/
+  const auto begin = uri.find("://");
+  if (begin == std::string::npos) return "";
+  uri = uri.substr(begin + 3);
+  return uri.substr(0, uri.find(':'));
 }
 
 struct Recorder {
@@ -80,6 +116,8 @@ struct Recorder {
   std::vector<std::vector<wavog_mapping::PlacedScan::ConstPtr>> scans{kVehicles.size()};
   wavog_mapping::FleetStatus::ConstPtr status;
   std::map<std::string, diagnostic_msgs::DiagnosticStatus> diagnostics;
+  std::vector<double> lag_max = std::vector<double>(kVehicles.size(), 0.0);  ///< over the run
+  std::vector<double> publish_lag_max = std::vector<double>(kVehicles.size(), 0.0);
 };
 
 bool saveMap(const std::string& service, const std::string& path) {
@@ -127,6 +165,10 @@ TEST(Fleet, ThreeVehiclesOneMap) {
       "/wavog_fleet/fleet_status", 10, [&rec](const wavog_mapping::FleetStatus::ConstPtr& s) {
         std::lock_guard<std::mutex> lock(rec.mutex);
         rec.status = s;
+        for (std::size_t k = 0; k < s->vehicles.size() && k < kVehicles.size(); ++k) {
+          rec.lag_max[k] = std::max(rec.lag_max[k], s->vehicles[k].lag_max);
+          rec.publish_lag_max[k] = std::max(rec.publish_lag_max[k], s->vehicles[k].publish_lag_max);
+        }
       }));
   subs.push_back(nh.subscribe<diagnostic_msgs::DiagnosticArray>(
       "/diagnostics", 100, [&rec](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
@@ -143,6 +185,11 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   pid_t& v3 = v3_child.pid;
   v2 = startMapper("v2");
   ASSERT_TRUE(ros::service::waitForService("/v2/wavog_mapping/save_map", ros::Duration(30.0)));
+  // Each process is reached at its own address (fleet.test), as on another machine.
+  EXPECT_EQ(ros::network::getHost(), kTestHost);
+  for (const char* node : {"/wavog_fleet", "/v1/wavog_mapping", "/v2/wavog_mapping"}) {
+    EXPECT_EQ(nodeHost(node), kHosts.at(node)) << node;
+  }
   ros::WallDuration(1.0).sleep();  // subscriptions connect
   player_child.pid = spawn({"rosbag", "play", "--clock", "-q", WAVOG_FLEET_BAG});
   const pid_t player = player_child.pid;
@@ -189,6 +236,7 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   ASSERT_TRUE(saveMap("/wavog_fleet/save_map", stem + "_fleet.wmap"));
   ASSERT_TRUE(saveMap("/v1/wavog_mapping/save_map", stem + "_v1.wmap"));
   ASSERT_GT(v3, 0);
+  EXPECT_EQ(nodeHost("/v3/wavog_mapping"), kHosts.at("/v3/wavog_mapping"));
   ASSERT_TRUE(saveMap("/v3/wavog_mapping/save_map", stem + "_v3.wmap"));
 
   // ---- v2 killed: stale, in ~fleet_status and /diagnostics; v1 streaming meanwhile.
@@ -205,10 +253,13 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   // ---- every scan the fleet received was integrated, in order (nothing late, nothing refused).
   wavog_mapping::FleetStatus::ConstPtr status;
   std::vector<std::vector<wavog_mapping::PlacedScan::ConstPtr>> scans;
+  std::vector<double> lag_max, publish_lag_max;
   {
     std::lock_guard<std::mutex> lock(rec.mutex);
     status = rec.status;
     scans = rec.scans;
+    lag_max = rec.lag_max;
+    publish_lag_max = rec.publish_lag_max;
   }
   ASSERT_TRUE(status);
   std::size_t total = 0;
@@ -224,6 +275,11 @@ TEST(Fleet, ThreeVehiclesOneMap) {
     EXPECT_GT(v.bytes, scans[k].size() * 1444u);  // 361 ranges of 4 bytes each, and more
     for (std::size_t i = 0; i < scans[k].size(); ++i) ASSERT_EQ(scans[k][i]->index, i);
     total += scans[k].size();
+    // A scan reaches the published layers after its integration: the largest lag to the layers'
+    // publication is at least the largest lag to integration (every scan was published: save_map
+    // publishes), and both include the reorder wait (3 wall s, fleet_map.yaml).
+    EXPECT_GE(lag_max[k], 2.9);  // sim time, /clock at 100 Hz
+    EXPECT_GE(publish_lag_max[k], lag_max[k]);
   }
   EXPECT_EQ(status->buffered, 0u);
 
@@ -263,6 +319,33 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   }
   EXPECT_EQ(differ, 0u) << "of " << rf.log_odds.size() << " cells (" << total << " scans)";
   EXPECT_GT(known, 100000u);
+
+  // ---- a fleet node started late catches up from map_file, the other fleet node's save_map: its
+  // map is that map, cell for cell, before any scan reaches it.
+  {
+    Child loader, late;
+    loader.pid = spawn({"rosparam", "load", std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_map.yaml",
+                        "/late/wavog_fleet"});
+    int status_code = -1;
+    ASSERT_EQ(waitpid(loader.pid, &status_code, 0), loader.pid);
+    loader.pid = -1;
+    ASSERT_TRUE(WIFEXITED(status_code) && WEXITSTATUS(status_code) == 0);
+    ros::param::set("/late/wavog_fleet/map_file", stem + "_fleet.wmap");
+    late.pid = spawn({WAVOG_FLEET_BIN, "__ns:=/late", "__name:=wavog_fleet"});
+    ASSERT_TRUE(saveMap("/late/wavog_fleet/save_map", stem + "_late.wmap"));
+  }
+  const wavog::WaveletMap caught = loadMap(config.map, stem + "_late.wmap");
+  wavog::CellBox bl;
+  ASSERT_TRUE(caught.bounds(0, &bl));
+  ASSERT_TRUE(bl.min_x == bf.min_x && bl.min_y == bf.min_y && bl.max_x == bf.max_x &&
+              bl.max_y == bf.max_y);
+  const wavog::Raster rl = caught.exportScale(0, bl, wavog::Aggregation::kMean);
+  std::size_t differ_late = 0;
+  for (std::size_t i = 0; i < rf.log_odds.size(); ++i) {
+    differ_late += rf.known[i] != rl.known[i] ||
+                   std::memcmp(&rf.log_odds[i], &rl.log_odds[i], sizeof(float)) != 0;
+  }
+  EXPECT_EQ(differ_late, 0u) << "of " << rf.log_odds.size() << " cells";
 
   // ---- ground truth: the fleet gets at least as many cells right as the best single vehicle.
   const double end = 28.0;

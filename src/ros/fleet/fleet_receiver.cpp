@@ -34,6 +34,8 @@ struct FleetReceiver::Vehicle {
   std::uint64_t next_index = 0;
   bool stale_reported = false;
   double lag_max_period = 0.0;
+  ros::Time oldest_unpublished;  ///< stamp of the oldest scan integrated since the last layers
+  double publish_lag_max_period = 0.0;
 };
 
 FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
@@ -171,6 +173,18 @@ void FleetReceiver::integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan&
   const double lag = (ros::Time::now() - m.header.stamp).toSec();
   c.lag = lag;
   v->lag_max_period = std::max(v->lag_max_period, lag);
+  if (v->oldest_unpublished.isZero() || m.header.stamp < v->oldest_unpublished) {
+    v->oldest_unpublished = m.header.stamp;
+  }
+}
+
+void FleetReceiver::layersPublishedLocked(const ros::Time& now) {
+  for (auto& v : vehicles_) {
+    if (v->oldest_unpublished.isZero()) continue;
+    v->publish_lag_max_period =
+        std::max(v->publish_lag_max_period, (now - v->oldest_unpublished).toSec());
+    v->oldest_unpublished = ros::Time();
+  }
 }
 
 std::uint64_t FleetReceiver::integratedLocked() const {
@@ -194,6 +208,8 @@ void FleetReceiver::publishStatus(const ros::Time& now) {
       v->c.stale = staleLocked(v.get(), wall);
       v->c.lag_max = v->lag_max_period;
       v->lag_max_period = 0.0;
+      v->c.publish_lag_max = v->publish_lag_max_period;
+      v->publish_lag_max_period = 0.0;
       s->vehicles.push_back(v->c);
     }
     s->buffered = buffer_.size();

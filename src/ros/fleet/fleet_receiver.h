@@ -41,6 +41,10 @@ class FleetReceiver {
 
   /// Scans integrated, all vehicles (under the mapper's lock).
   std::uint64_t integratedLocked() const;
+  /// The map layers were just read for publication at `now` (under the mapper's lock): every
+  /// scan integrated since the previous publication is now in the published map; records its
+  /// publish lag (VehicleStatus.publish_lag_max).
+  void layersPublishedLocked(const ros::Time& now);
   /// Builds and publishes ~fleet_status (takes the lock itself).
   void publishStatus(const ros::Time& now);
   /// Integrates everything still buffered, in order (takes the lock itself); returns how many.
