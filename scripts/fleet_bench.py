@@ -16,10 +16,11 @@ Writes OUT/bench.md and OUT/bench.json. usage: fleet_bench.py BIN_DIR SOURCE_DIR
 import json
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
+
+from fleet_common import free_port, cpu_seconds
 
 BIN, SRC, OUT = sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3])
 DURATION = float(sys.argv[4]) if len(sys.argv) > 4 else 20.0
@@ -27,20 +28,6 @@ RATES = [float(r) for r in sys.argv[5].split(",")] if len(sys.argv) > 5 else [1.
 N = 8
 VEHICLES = ["v%d" % (k + 1) for k in range(N)]
 RECORD_RATE = 0.5
-
-
-def free_port():
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-def cpu_seconds(pid):
-    with open("/proc/%d/stat" % pid) as f:
-        fields = f.read().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 class Graph:
@@ -157,7 +144,7 @@ def play_into_fleet(g, fleet_bag, rate):
         cpu_play = cpu_seconds(fleet.pid) - cpu0
         # The last fleet_status: the clock stopped with the bag, and save_map publishes it.
         from wavog_mapping.srv import SaveMap
-        r = rospy.ServiceProxy("/wavog_fleet/save_map", SaveMap)(path="bench_%g.wavog" % rate)
+        rospy.ServiceProxy("/wavog_fleet/save_map", SaveMap)(path="bench_%g.wavog" % rate)
         time.sleep(1.0)
         status = last.get("status")
         sub.unregister()

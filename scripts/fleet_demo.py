@@ -14,30 +14,17 @@ usage: fleet_demo.py BIN_DIR SOURCE_DIR OUT [DURATION]
 import json
 import os
 import signal
-import socket
 import struct
 import subprocess
 import sys
 import time
 
+from fleet_common import free_port, cpu_seconds
+
 BIN, SRC, OUT = sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3])
 DURATION = float(sys.argv[4]) if len(sys.argv) > 4 else 30.0
 VEHICLES = ["v1", "v2", "v3"]
 EPOCH = 1.7e9
-
-
-def free_port():
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-def cpu_seconds(pid):
-    with open("/proc/%d/stat" % pid) as f:
-        fields = f.read().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def main():

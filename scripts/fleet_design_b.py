@@ -17,11 +17,12 @@ import json
 import os
 import shutil
 import signal
-import socket
 import struct
 import subprocess
 import sys
 import time
+
+from fleet_common import free_port
 
 BIN, SRC, OUT, BAG = sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4]
 VEHICLES = (sys.argv[5] if len(sys.argv) > 5 else "v1").split(",")
@@ -60,14 +61,6 @@ def blocks_of(path):
             at = node(at, levels)
         out[(bx, by)] = data[start:at]
     return out
-
-
-def free_port():
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def record_snapshots(snap_dir):
