@@ -6,7 +6,9 @@ find_package(Threads REQUIRED)
 add_library(wavog_test_support STATIC test/core/dense_reference.cpp test/core/test_support.cpp)
 target_link_libraries(wavog_test_support PUBLIC wavog_core wavog_io GTest::GTest Threads::Threads
   ZLIB::ZLIB)
-target_include_directories(wavog_test_support PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/test/core)
+# The tests of the core's private parts include them as ../../src/core/<part>/<file>.
+target_include_directories(wavog_test_support PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/test/core
+  ${CMAKE_CURRENT_SOURCE_DIR}/src/core)
 target_compile_options(wavog_test_support PRIVATE ${WAVOG_WARNINGS})
 target_compile_definitions(wavog_test_support PUBLIC
   WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")

@@ -4,7 +4,7 @@
 
 #include <functional>
 
-#include "../../src/core/map_impl.h"
+#include "../../src/core/storage/map_impl.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {

@@ -1,5 +1,6 @@
-// The sparse store of the payload cells (src/core/cell_runs.h) and the reflection map's bits of the
-// cells that hold an entry (src/core/reflection_store.h), against a std::map of the same cells:
+// The sparse store of the payload cells (src/core/storage/cell_runs.h) and the reflection map's
+// bits of the cells that hold an entry (src/core/payloads/reflection_store.h), against a std::map
+// of the same cells:
 // random batches of updates and new cells as a scan brings them (clustered codes), drops, removals
 // and merges keep every entry once, both runs ascending, and the bits set exactly where an entry
 // is; the gallops find what std::lower_bound / std::upper_bound find.
@@ -11,8 +12,8 @@
 #include <random>
 #include <vector>
 
-#include "../../src/core/cell_runs.h"
-#include "../../src/core/reflection_store.h"
+#include "../../src/core/storage/cell_runs.h"
+#include "../../src/core/payloads/reflection_store.h"
 
 namespace wavog_test {
 namespace {

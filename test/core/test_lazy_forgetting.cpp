@@ -8,7 +8,7 @@
 #include <random>
 #include <tuple>
 
-#include "../../src/core/cell_reader.h"
+#include "../../src/core/storage/cell_reader.h"
 #include "dense_reference.h"
 #include "map_access.h"
 #include "test_support.h"

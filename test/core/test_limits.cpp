@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "../../src/core/scan_classifier.h"
+#include "../../src/core/classify/scan_classifier.h"
 #include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/motion_compensation.h"
 #include "wavog_mapping/core/wavelet_map.h"

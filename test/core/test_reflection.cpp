@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "../../src/core/reflection_store.h"
+#include "../../src/core/payloads/reflection_store.h"
 #include "dense_reference.h"
 #include "test_support.h"
 

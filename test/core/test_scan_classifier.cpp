@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <string>
 
-#include "../../src/core/scan_classifier.h"
+#include "../../src/core/classify/scan_classifier.h"
 #include "dense_reference.h"
 #include "test_support.h"
 #include "wavog_mapping/core/wavelet_map.h"

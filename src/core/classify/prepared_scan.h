@@ -1,0 +1,129 @@
+// The per-scan data of the integration: the scan's geometry, each beam's kind and E / U limits,
+// the min / max table over beam intervals, the hit cells and the sector boundary directions
+// (ALGORITHM.md section 3.1). One copy of each quantity: the squared limits are level 0 of the
+// min / max table. Built once per scan by prepare(), read by the ScanClassifier.
+// Not installed; included only by src/core/* and the core tests.
+#ifndef WAVOG_MAPPING_SRC_CORE_CLASSIFY_PREPARED_SCAN_H_
+#define WAVOG_MAPPING_SRC_CORE_CLASSIFY_PREPARED_SCAN_H_
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "classify/scan_numerics.h"
+#include "wavog_mapping/core/params.h"
+#include "wavog_mapping/core/types.h"
+
+namespace wavog {
+struct IntegrateStats;
+
+namespace detail {
+
+/// A beam per REP 117: no information, a return (hit), or a no-return that clears free space.
+enum class BeamKind : std::uint8_t { kInvalid, kHit, kClear };
+
+/// The exact leaf tests of one beam on a cell centre's squared distance d2 (see sqrtBelow):
+/// E when d2 < e (-1: an invalid beam, never E), else O when d2 <= o (-1: not a hit, never O).
+struct LeafTest {
+  double e = -1.0;
+  double o = -1.0;
+};
+
+/// One scan, ready for classification. Beams are reordered by ascending bearing (inc > 0).
+struct PreparedScan {
+  /// Validates `scan` and `pose` and fills every field (buffers are reused between scans).
+  /// Beam counts go to `st`. Anything but kOk leaves the fields unusable.
+  ScanStatus prepare(const MapParams& params, const Pose2& pose, const ScanView& scan,
+                     IntegrateStats* st);
+  /// Releases the buffers when they were sized for more than kScratchKeepBeams beams (limits.h),
+  /// so one absurd scan does not keep its memory; ordinary scans keep reusing theirs.
+  void releaseIfLarge();
+
+  double px = 0, py = 0, theta = 0;  ///< sensor pose (map frame)
+  double amin = 0, inc = 0;          ///< beam j at bearing amin + j * inc (sensor frame), inc > 0
+  double seam = 0;                   ///< bearings are normalised into [seam, seam + 2 pi)
+  double res = 0;                    ///< cell size (m)
+  int n = 0;                         ///< beams
+  double reach = 0;                  ///< largest U limit over the valid beams (m)
+  // Bearing constants of the fast beam lookup.
+  double seam_map = 0;    ///< theta + seam reduced to [-pi, pi): the seam, map frame
+  double inv_inc = 0;     ///< 1 / inc
+  double t_seam = 0;      ///< (seam - amin) / inc
+  double fast_guard = 0;  ///< |t - (j + 1/2)| beyond which fastAtan2 gives lround(t)
+
+  std::vector<BeamKind> kind;              ///< per beam
+  std::vector<LeafTest> leaf;              ///< per beam: exact leaf thresholds
+  std::vector<std::int64_t> hit_x, hit_y;  ///< per beam: the cell of its endpoint (hit beams)
+  std::vector<double> end_x, end_y;        ///< per beam: its endpoint, map frame (hit beams)
+  std::vector<std::uint64_t> hits;         ///< sorted cellKey()s of the hit endpoints
+  std::vector<int> invalid_prefix;         ///< invalid_prefix[j] = invalid beams in [0, j)
+  /// Min of the squared E limits and max of the squared U limits over [j, j + 2^k), level-major
+  /// (n per level); level 0 holds each beam's own squared limits (squaredLimit; -1 for none).
+  std::vector<double> min_e2, max_u2;
+  std::vector<double> bnd_x, bnd_y;  ///< boundary k between sectors k-1 and k: unit direction
+
+  /// Squared E and U limits of beam j.
+  double e2(std::size_t j) const { return min_e2[j]; }
+  double u2(std::size_t j) const { return max_u2[j]; }
+  /// Min squared E limit / max squared U limit over beams [lo, hi] (lo <= hi), in O(1).
+  double minE2(int lo, int hi) const {
+    const int k = 31 - __builtin_clz(static_cast<unsigned>(hi - lo + 1));
+    const std::size_t base = static_cast<std::size_t>(k) * static_cast<std::size_t>(n);
+    return std::min(min_e2[base + static_cast<std::size_t>(lo)],
+                    min_e2[base + static_cast<std::size_t>(hi - (1 << k) + 1)]);
+  }
+  double maxU2(int lo, int hi) const {
+    const int k = 31 - __builtin_clz(static_cast<unsigned>(hi - lo + 1));
+    const std::size_t base = static_cast<std::size_t>(k) * static_cast<std::size_t>(n);
+    return std::max(max_u2[base + static_cast<std::size_t>(lo)],
+                    max_u2[base + static_cast<std::size_t>(hi - (1 << k) + 1)]);
+  }
+  /// True if a beam in [lo, hi] is invalid.
+  bool anyInvalid(int lo, int hi) const {
+    return invalid_prefix[static_cast<std::size_t>(hi) + 1] >
+           invalid_prefix[static_cast<std::size_t>(lo)];
+  }
+  /// True if beam j is a hit whose endpoint lies in cell (ix, iy).
+  bool hitsCell(std::size_t j, std::int64_t ix, std::int64_t iy) const {
+    return kind[j] == BeamKind::kHit && hit_x[j] == ix && hit_y[j] == iy;
+  }
+
+  static std::uint64_t cellKey(std::int64_t ix, std::int64_t iy) {
+    return (static_cast<std::uint64_t>(ix + (std::int64_t{1} << 31)) << 32) ^
+           static_cast<std::uint64_t>(iy + (std::int64_t{1} << 31));
+  }
+  /// A sensor-frame bearing normalised into [seam, seam + 2 pi).
+  double normalise(double bearing) const {
+    return bearing - kTwoPi * std::floor((bearing - seam) / kTwoPi);
+  }
+  /// A map-frame direction angle (from fastAtan2, in [-pi, pi]) as its sensor-frame bearing's
+  /// offset past the seam, in [0, 2 pi). Within a few ulps of normalise() - seam.
+  double offSeam(double map_angle) const {
+    double v = map_angle - seam_map;
+    if (v < 0.0) v += kTwoPi;
+    if (v >= kTwoPi) v -= kTwoPi;
+    return v;
+  }
+
+ private:
+  void setGeometry(const Pose2& pose, const ScanView& scan, double res);
+  void setBoundaries();
+  /// The range limits of one scan's beams (m): no return at or beyond sensor_max, the given
+  /// limit (min of range_max and max_range) capped, like the no-return clearing distance, by the
+  /// hard limit (limits.h).
+  struct BeamLimits {
+    double given = 0, sensor_max = 0, clear = 0, half_band = 0;
+  };
+  static BeamLimits beamLimits(const MapParams& params, const ScanView& scan);
+  void setBeams(const BeamLimits& limits, const ScanView& scan, IntegrateStats* st);
+  void buildTables();
+  int tableLevels();  // sizes the tables for n beams; returns their levels
+
+  std::vector<float> ranges_;  // work copy, in ascending bearing order
+};
+
+}  // namespace detail
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_SRC_CORE_CLASSIFY_PREPARED_SCAN_H_

@@ -1,0 +1,265 @@
+// WaveletMap::integrate: one scan into the map (ALGORITHM.md sections 3 and 6). The scan is
+// prepared and classified by the ScanClassifier (scan_classifier.h); every block within its
+// reach that is not U goes through the quadtree update Integrator<P> (quadtree_update.h), one
+// instantiation per update policy. The touched blocks are found and created first, on the calling
+// thread; with num_threads != 1 they are then updated on the map's worker threads.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "update/block_update.h"
+#include "storage/map_impl.h"
+#include "classify/scan_classifier.h"
+#include "wavog_mapping/core/wavelet_map.h"
+
+namespace wavog {
+namespace detail {
+// The update with the Gaussians' forgetting is compiled in its own file (integrate_ndt.cpp), so
+// that it does not change how the compiler inlines the others.
+// So are the updates with the hits of the reflection map (integrate_reflection.cpp).
+#define WAVOG_UPDATE_BLOCKS(P, NDT, HITS)                                                          \
+  extern template std::uint64_t updateBlocks<P, NDT, HITS>(                                        \
+      WaveletMap::Impl&, NodeStore&, const ScanClassifier&, const PolicyConsts&, const NdtConsts*, \
+      const HitConsts*, const std::vector<BlockJob>&, std::atomic<std::size_t>*);
+WAVOG_UPDATE_BLOCKS_ALL
+#undef WAVOG_UPDATE_BLOCKS
+}  // namespace detail
+
+namespace {
+
+using detail::ScanClassifier;
+
+// Numerical floor of the "E update changes nothing" test (log-odds).
+constexpr double kUnchangedFloor = 1e-9;
+
+// Box of finest cells [min, max) holding every cell within `reach` (m) of (px, py). prepare()
+// refuses a scan whose pose plus reach leaves the extent (limits.h), so the casts are exact.
+CellBox reachBox(double px, double py, double reach, double res) {
+  CellBox box;
+  box.min_x = static_cast<std::int64_t>(std::floor((px - reach) / res));
+  box.min_y = static_cast<std::int64_t>(std::floor((py - reach) / res));
+  box.max_x = static_cast<std::int64_t>(std::floor((px + reach) / res)) + 1;
+  box.max_y = static_cast<std::int64_t>(std::floor((py + reach) / res)) + 1;
+  return box;
+}
+
+// The NDT policy of one scan (params.h, MapParams::ndt): forgetting by the scan's rate, the
+// clamp policies' weight cap, sums otherwise.
+detail::NdtConsts ndtConsts(const MapParams& p, double a, double g) {
+  detail::NdtConsts c;
+  c.min_weight = p.ndt_min_weight;
+  if (p.policy.type == PolicyType::kForget) {
+    c.a = a;
+    c.g = g;
+  } else if (p.policy.type == PolicyType::kClamp || p.policy.type == PolicyType::kClampUpper) {
+    c.cap = p.ndt_max_weight;
+  }
+  return c;
+}
+
+// Node groups one block can take in one scan at most: a group per node of levels 2..L (a
+// block's live and spare groups never exceed that, and fresh ones are taken only when its
+// spares are used up).
+std::size_t maxGroupsPerBlock(int levels) {
+  return ((std::size_t{1} << (2 * (levels - 1))) - 1) / 3;
+}
+
+// Participants of parallel integrations: num_threads, 0 meaning every core.
+int threadsFor(const MapParams& p) {
+  if (p.num_threads != 0) return p.num_threads;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+// Puts the blocks that are likely the most work first, so that the threads of a parallel
+// integration finish together instead of one of them starting a heavy block last: blocks that may
+// hold hits (kMixed) before free or partly unknown ones, nearer the sensor (more beams, more
+// cells of the fan) before farther. Only the order of the work changes, not its result.
+void orderByWork(const detail::PreparedScan& ps, double block_size,
+                 std::vector<detail::BlockJob>* jobs) {
+  const auto cost_rank = [&](const detail::BlockJob& j) {
+    const double res = ps.res;
+    const double cx = (static_cast<double>(j.ix0) * res + 0.5 * block_size) - ps.px;
+    const double cy = (static_cast<double>(j.iy0) * res + 0.5 * block_size) - ps.py;
+    return std::make_pair(j.box.cls == CellClass::kMixed ? 0 : 1, cx * cx + cy * cy);
+  };
+  std::stable_sort(jobs->begin(), jobs->end(),
+                   [&](const detail::BlockJob& a, const detail::BlockJob& b) {
+                     return cost_rank(a) < cost_rank(b);
+                   });
+}
+
+template <PolicyType P>
+std::uint64_t updateBlocksFor(WaveletMap::Impl& impl, detail::NodeStore& store,
+                              const ScanClassifier& cls, const detail::PolicyConsts& pc,
+                              const detail::NdtConsts* ndt, const detail::HitConsts* hits,
+                              const std::vector<detail::BlockJob>& jobs,
+                              std::atomic<std::size_t>* next) {
+  // The Gaussians: "forget" is the one policy whose observations change them.
+  if constexpr (P == PolicyType::kForget) {
+    if (ndt != nullptr && ndt->forgets()) {
+      if (hits != nullptr) {
+        return detail::updateBlocks<P, true, true>(impl, store, cls, pc, ndt, hits, jobs, next);
+      }
+      return detail::updateBlocks<P, true>(impl, store, cls, pc, ndt, hits, jobs, next);
+    }
+  }
+  if (hits != nullptr) {
+    return detail::updateBlocks<P, false, true>(impl, store, cls, pc, ndt, hits, jobs, next);
+  }
+  return detail::updateBlocks<P, false>(impl, store, cls, pc, ndt, hits, jobs, next);
+}
+
+// `workers`: the map's worker threads (made here on first use), shared by its reflection layers.
+template <PolicyType P>
+std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, double period,
+                           std::unique_ptr<detail::WorkerPool>* workers, IntegrateStats* st) {
+  const MapParams& p = impl.params;
+  // Forgetting: gamma per scan, or from the scan's period with forget_half_life.
+  const std::uint64_t units = impl.scanUnits(period);
+  const double a = impl.half_life ? impl.scanFactor(units) : impl.a;
+  const double g = impl.half_life ? 1.0 - a : p.policy.gamma;
+  const detail::PolicyConsts pc{p.sensor.odd_occ,
+                                p.sensor.odd_emp,
+                                a,
+                                P == PolicyType::kForget ? g : 0.0,
+                                p.policy.clamp_min,
+                                p.policy.clamp_max,
+                                std::max(p.skip_tolerance, kUnchangedFloor),
+                                units};
+  const detail::PreparedScan& ps = cls.scan();
+  const int L = impl.levels;
+  const double block_size = static_cast<double>(std::int64_t{1} << L) * ps.res;
+  const CellBox blocks = reachBox(ps.px, ps.py, ps.reach, block_size);
+  // Serial: classify the blocks and create the touched ones (the hash changes only here, in the
+  // same order whatever the thread count, so its iteration order, and the saved file, are too).
+  thread_local std::vector<detail::BlockJob> job_buffer;  // reused from scan to scan
+  std::vector<detail::BlockJob>& jobs = job_buffer;       // the workers read this thread's copy
+  jobs.clear();
+  std::uint64_t visited = 0;
+  for (std::int64_t by = blocks.min_y; by < blocks.max_y; ++by) {
+    for (std::int64_t bx = blocks.min_x; bx < blocks.max_x; ++bx) {
+      const std::int64_t ix0 = detail::scaleUp(bx, L), iy0 = detail::scaleUp(by, L);
+      const detail::SquareInfo box = cls.classifySquare(L, ix0, iy0);
+      ++visited;
+      if (box.cls == CellClass::kUnknown) continue;
+      jobs.push_back({&impl.getOrCreateBlock(bx, by), ix0, iy0, box});
+    }
+  }
+  // NDT: the scan's end-points by block; a block takes its Gaussians with its first end-point.
+  thread_local detail::NdtScanPoints ndt_points;
+  detail::NdtConsts ndt_consts;
+  const detail::NdtConsts* ndt = nullptr;
+  if (p.ndt) {
+    ndt_consts = ndtConsts(p, a, g);
+    ndt = &ndt_consts;
+    ndt_points.build(ps, L);
+    for (detail::BlockJob& j : jobs) {
+      ndt_points.inBlock(
+          detail::blockKey(detail::floorShift(j.ix0, L), detail::floorShift(j.iy0, L)), &j.points,
+          &j.points_end);
+      if (j.points != j.points_end && !j.block->ndt) {
+        j.block->ndt = std::make_unique<detail::NdtCells>();
+      }
+    }
+  }
+  // Reflection: the hits of the occupied cells (none to keep under kPrior and kLayers).
+  detail::HitConsts hit_consts;
+  const detail::HitConsts* hits = nullptr;
+  if (impl.reflection_mode == ReflectionMode::kDerived ||
+      impl.reflection_mode == ReflectionMode::kCounts) {
+    hit_consts.ratios = P == PolicyType::kForget;
+    hit_consts.pairs = detail::boundsCounts(P);
+    hit_consts.a = a;
+    hit_consts.g = g;
+    if constexpr (detail::boundsCounts(P)) {
+      hit_consts.bound = detail::countBound(p);
+      hit_consts.empty_bound = detail::emptyBound(p);
+    }
+    hit_consts.basis = impl.reflection_basis;
+    hits = &hit_consts;
+  }
+  st->blocks_touched = static_cast<std::uint32_t>(jobs.size());
+  // The blocks are independent: each one's update reads only the scan and the parameters and
+  // changes only its own nodes, taking node groups from its own spares (NodeStore), so the result
+  // does not depend on which thread updates which block, nor in which order.
+  // The chunk table grows here, whatever the thread count, so that its size does not depend on it.
+  impl.pool.reserveFresh(jobs.size() * maxGroupsPerBlock(L));
+  const int threads = std::min(threadsFor(p), static_cast<int>(jobs.size()));
+  std::atomic<std::size_t> next{0};
+  if (threads <= 1) {
+    detail::NodeStore store(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
+    return visited + updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
+  }
+  orderByWork(ps, block_size, &jobs);
+  if (!*workers || (*workers)->threads() != threadsFor(p)) {
+    *workers = std::make_unique<detail::WorkerPool>(threadsFor(p));
+  }
+  // Per participant: visits and node / group count changes (modulo 2^64), on their own cache
+  // lines.
+  struct alignas(64) Tally {
+    std::uint64_t visited = 0;
+    std::size_t nodes = 0, groups = 0;
+  };
+  std::vector<Tally> tallies(static_cast<std::size_t>((*workers)->threads()));
+  const auto active = static_cast<std::size_t>(threads);
+  (*workers)->run([&](int t) {
+    const auto tu = static_cast<std::size_t>(t);
+    if (tu >= active) return;
+    Tally& tally = tallies[tu];
+    detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
+    tally.visited = updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
+  });
+  for (const Tally& tally : tallies) {
+    visited += tally.visited;
+    impl.nodes += tally.nodes;
+    impl.pool.addLive(tally.groups);
+  }
+  return visited;
+}
+
+// One instantiation per policy, in the order of PolicyType's enumerators.
+using IntegrateFn = std::uint64_t (*)(WaveletMap::Impl&, const ScanClassifier&, double,
+                                      std::unique_ptr<detail::WorkerPool>*, IntegrateStats*);
+constexpr IntegrateFn kIntegrateFor[] = {
+    &integrateAll<PolicyType::kNone>,       &integrateAll<PolicyType::kMax>,
+    &integrateAll<PolicyType::kClamp>,      &integrateAll<PolicyType::kForget>,
+    &integrateAll<PolicyType::kClampLower>, &integrateAll<PolicyType::kClampUpper>};
+static_assert(static_cast<int>(PolicyType::kNone) == 0 &&
+                  static_cast<int>(PolicyType::kClampUpper) == 5,
+              "kIntegrateFor follows PolicyType's order");
+
+}  // namespace
+
+IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& scan) {
+  IntegrateStats st;
+  // Per-thread scratch: its buffers are reused from scan to scan (see the header's
+  // thread-safety note).
+  thread_local ScanClassifier classifier;
+  st.status = classifier.prepare(impl_->params, sensor_pose, scan, &st);
+  if (st.status != ScanStatus::kOk) {
+    classifier.releaseIfLarge();
+    impl_->nodes_visited_last = 0;
+    return st;
+  }
+  const detail::PreparedScan& ps = classifier.scan();
+  st.touched = reachBox(ps.px, ps.py, ps.reach, ps.res);
+  const auto policy = static_cast<std::size_t>(impl_->params.policy.type);
+  st.nodes_visited = kIntegrateFor[policy](*impl_, classifier, scan.period, &impl_->workers, &st);
+  // The reflection layers (reflection.cpp; kCounts, kLayers) take the same classification.
+  for (WaveletMap* layer : {impl_->hits_layer.get(), impl_->misses_layer.get()}) {
+    if (layer == nullptr) continue;
+    Impl& l = *layer->impl_;
+    IntegrateStats layer_st;
+    l.nodes_visited_last = kIntegrateFor[static_cast<std::size_t>(l.params.policy.type)](
+        l, classifier, scan.period, &impl_->workers, &layer_st);
+  }
+  classifier.releaseIfLarge();
+  impl_->nodes_visited_last = st.nodes_visited;
+  return st;
+}
+
+}  // namespace wavog
