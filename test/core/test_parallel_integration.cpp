@@ -74,6 +74,7 @@ class ThreadRun {
     }
     return first.blocks_touched;
   }
+  const WaveletMap& first() const { return *maps_[0]; }
   void clearBox(double x0, double y0, double x1, double y1) {
     for (auto& m : maps_) m->clearBox(x0, y0, x1, y1);
   }
@@ -133,6 +134,47 @@ TEST(ParallelIntegration, RandomScansGiveTheSameMapForOneTwoAndFourThreads) {
     }
     EXPECT_GT(blocks, 60u * 4) << np.name << ": too few blocks per scan to share between threads";
     run.expectSame(np.name);
+  }
+}
+
+// A scan of at most 8 blocks is split below their roots (src/core/update/split_plan.h), and
+// threads share the parts of one block: one, two and four threads still give the same map, and
+// it is, cell for cell, the map of the walk of whole blocks (a map with NDT cells is not split,
+// and they do not change its occupancy). Blocks of 8 levels split 3 levels down, of 5 levels 2.
+TEST(ParallelIntegration, ScansOfFewBlocksAreSplitAndGiveTheSameMap) {
+  struct Case {
+    int levels;
+    double half_extent;  // m: scans within +-half / 2, ranges below 0.45 half
+  };
+  for (const Case c : {Case{8, 20.0}, Case{5, 3.0}}) {
+    auto configs = everyPolicy(0.1, c.levels);
+    NamedParams eager = configs[5];
+    ASSERT_EQ(eager.name, "forget");
+    eager.name = "forget_eager";
+    eager.params.lazy_forgetting = false;
+    configs.push_back(eager);
+    for (const auto& np : configs) {
+      const std::string what = np.name + ", " + std::to_string(c.levels) + " levels";
+      ThreadRun run(np.params);
+      MapParams whole_params = np.params;
+      whole_params.ndt = true;
+      WaveletMap whole(whole_params);
+      RandomScans scans(5, c.half_extent);
+      for (int i = 0; i < 50; ++i) {
+        const OwnedScan s = scans.next();
+        const std::uint32_t blocks = run.integrate(s, what + ", scan " + std::to_string(i));
+        EXPECT_LE(blocks, 8u) << what << ": the scan is not split";
+        whole.integrate(s.pose, s.view());
+        if (i == 25) {  // clearing frees nodes to the blocks' spares, which the parts then take
+          const double h = 0.25 * c.half_extent;
+          run.clearBox(-h, -h, h, 0.5 * h);
+          whole.clearBox(-h, -h, h, 0.5 * h);
+        }
+      }
+      run.expectSame(what);
+      EXPECT_EQ(run.first().stats().nodes, whole.stats().nodes) << what;
+      expectSameCells(run.first(), whole, static_cast<int>(c.half_extent / 0.1), 0.0);
+    }
   }
 }
 

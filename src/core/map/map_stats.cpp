@@ -29,10 +29,9 @@ MapStats WaveletMap::stats(bool count_observed) const {
   st.nodes = impl.nodes;
   // Hash: one heap node per block (key, Block, next pointer, cached hash) plus the bucket array.
   const std::size_t per_block = sizeof(std::uint64_t) + sizeof(Block) + 2 * sizeof(void*);
-  std::size_t spare = 0;  // the blocks' lists of spare node groups
-  for (const auto& kv : impl.blocks) spare += kv.second.spare.capacity() * sizeof(std::uint32_t);
+  // The blocks' spare node groups are chained in the pool's chunks (bytes_reserved).
   const std::size_t rest = impl.blocks.size() * per_block +
-                           impl.blocks.bucket_count() * sizeof(void*) + sizeof(Impl) + spare;
+                           impl.blocks.bucket_count() * sizeof(void*) + sizeof(Impl);
   std::size_t hit_bytes = 0;
   for (const auto& kv : impl.blocks) {
     const detail::HitCells* hits = kv.second.hits.get();

@@ -4,6 +4,7 @@
 #ifndef WAVOG_MAPPING_SRC_CORE_STORAGE_BLOCK_HASH_H_
 #define WAVOG_MAPPING_SRC_CORE_STORAGE_BLOCK_HASH_H_
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -17,6 +18,9 @@
 namespace wavog {
 namespace detail {
 
+/// Parts of a block the split walk updates apart, at most (update/split_plan.h).
+constexpr std::size_t kMaxBlockParts = 64;
+
 /// One hashed block: a quadtree of block_levels levels, its average and its root node.
 struct Block {
   double s = 0.0;          ///< mean log-odds of the block (exact, never lazy)
@@ -24,8 +28,12 @@ struct Block {
   bool has_root = false;   ///< false: the block is uniform at s
   bool known_all = false;  ///< every cell observed
   bool known_any = false;  ///< some cell observed
-  /// Node groups this block freed during integrations, reused by its next ones (NodeStore).
-  std::vector<std::uint32_t> spare;
+  /// Node groups this block freed during integrations, reused by its next ones: the first of a
+  /// spare list (NodePool::pushSpare), 0 when empty.
+  std::uint32_t spare = 0;
+  /// The spare lists of the block's parts (update/split_plan.h: the slots split_levels below
+  /// its root, which threads update apart).
+  std::array<std::uint32_t, kMaxBlockParts> part_spare{};
   /// MapParams::ndt: the Gaussians of its cells (made with the first end-point in the block).
   std::unique_ptr<NdtCells> ndt;
   /// MapParams::reflection: the hits of its cells (made with the first hit in the block).

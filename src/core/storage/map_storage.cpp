@@ -160,7 +160,8 @@ void WaveletMap::Impl::dropIfEmpty(std::int64_t bx, std::int64_t by) {
 void WaveletMap::Impl::eraseBlock(std::uint64_t key) {
   auto it = blocks.find(key);
   if (it == blocks.end()) return;
-  for (std::uint32_t g : it->second.spare) pool.recycle(g);
+  pool.recycleSpares(&it->second.spare);
+  for (std::uint32_t& part : it->second.part_spare) pool.recycleSpares(&part);
   blocks.erase(it);
 }
 

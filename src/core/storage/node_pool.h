@@ -94,12 +94,29 @@ class NodePool {
   }
   /// Puts group g, not counted as live, on the pool's own free list (one thread at a time).
   void recycle(std::uint32_t g) { free_.push_back(g); }
-  /// Moves up to `count` groups of the pool's own free list to `spare` (one thread at a time).
-  void lend(std::size_t count, std::vector<std::uint32_t>* spare) {
+  /// Moves up to `count` groups of the pool's own free list to the spare list whose first group
+  /// is *spare (one thread at a time).
+  void lend(std::size_t count, std::uint32_t* spare) {
     for (; count > 0 && !free_.empty(); --count) {
-      spare->push_back(free_.back());
+      pushSpare(spare, free_.back());
       free_.pop_back();
     }
+  }
+  /// Spare lists (a block's, or a part's of a block, NodeStore): the groups are chained through
+  /// their own storage (a spare group holds no node), *list is the first one, 0 ends the list.
+  void pushSpare(std::uint32_t* list, std::uint32_t g) {
+    group(g).n[0].children = *list;
+    *list = g;
+  }
+  /// The first group of a non-empty spare list, taken off it (not cleared).
+  std::uint32_t popSpare(std::uint32_t* list) {
+    const std::uint32_t g = *list;
+    *list = group(g).n[0].children;
+    return g;
+  }
+  /// Puts every group of a spare list on the pool's own free list (not counted as live).
+  void recycleSpares(std::uint32_t* list) {
+    while (*list != 0) recycle(popSpare(list));
   }
   /// A cleared, never used group. Safe from several threads within the reserved room; it does
   /// not count the group as live (the caller does, see NodeStore).
@@ -190,25 +207,25 @@ class NodePool {
 };
 
 /// Where the node operations of one thread take node groups from and give them back to, and the
-/// counts they change: the pool's own free list (one thread at a time), or, while a block is
-/// integrated, that block's spare groups (so that a block reuses only its own groups and the
-/// map's size does not depend on which thread integrated which block), then fresh ones.
+/// counts they change: the pool's own free list (one thread at a time), or, while a block (or a
+/// part of one, update/split_plan.h) is integrated, its spare list (so that a block reuses only
+/// its own groups and the map's size does not depend on which thread integrated which block),
+/// then fresh ones.
 /// `nodes` and `groups` point at the counters to change (modulo 2^64: a thread's own counters
 /// may go below zero and are added to the map's afterwards).
 class NodeStore {
  public:
-  NodeStore(NodePool& pool, std::vector<std::uint32_t>* spare, std::size_t* nodes,
+  NodeStore(NodePool& pool, std::uint32_t* spare, std::size_t* nodes,
             std::size_t* groups)
       : pool_(pool), spare_(spare), nodes_(nodes), groups_(groups) {}
   NodePool& pool() const { return pool_; }
-  /// Switches to the spare groups of another block.
-  void useSpare(std::vector<std::uint32_t>* spare) { spare_ = spare; }
+  /// Switches to the spare list of another block or part (NodePool::pushSpare).
+  void useSpare(std::uint32_t* spare) { spare_ = spare; }
   std::uint32_t allocate() {
     if (spare_ == nullptr) return pool_.allocate();
     std::uint32_t g;
-    if (!spare_->empty()) {
-      g = spare_->back();
-      spare_->pop_back();
+    if (*spare_ != 0) {
+      g = pool_.popSpare(spare_);
       pool_.group(g) = NodeGroup{};
     } else {
       g = pool_.fresh();
@@ -221,7 +238,7 @@ class NodeStore {
       pool_.release(g);
       return;
     }
-    spare_->push_back(g);
+    pool_.pushSpare(spare_, g);
     --*groups_;
   }
   void nodeAdded() { ++*nodes_; }
@@ -229,7 +246,7 @@ class NodeStore {
 
  private:
   NodePool& pool_;
-  std::vector<std::uint32_t>* spare_;
+  std::uint32_t* spare_;
   std::size_t* nodes_;
   std::size_t* groups_;
 };

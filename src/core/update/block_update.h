@@ -13,6 +13,7 @@
 #include "storage/map_impl.h"
 #include "payloads/ndt_update.h"
 #include "update/quadtree_update.h"
+#include "update/split_plan.h"
 #include "payloads/reflection_update.h"
 
 namespace wavog {
@@ -57,6 +58,61 @@ template <PolicyType P, bool kNdt, bool kHits = false>
     if constexpr (kHits) hit_update.finish(*j.block, j.ix0, j.iy0);
   }
   return integrator.visited();
+}
+
+// The split walk (split_plan.h), one step per function so that each thread's part of the work
+// is the hot code of its own: planBlocks() (calling thread) walks the top levels of every block
+// of `jobs` into `plan`; updateParts() (every thread) updates the parts whose indices (in
+// plan->parts) it takes from `next`; settleBlocks() (calling thread) folds and settles. Each
+// returns the nodes it visited. The blocks' spare groups go to their parts between the first two.
+template <PolicyType P>
+[[gnu::noinline]] std::uint64_t planBlocks(WaveletMap::Impl& impl, NodeStore& store,
+                                           const ScanClassifier& cls, const PolicyConsts& pc,
+                                           const std::vector<BlockJob>& jobs, int split,
+                                           SplitPlan* plan) {
+  Integrator<P> integrator(impl, store, cls, pc);
+  for (const BlockJob& j : jobs) {
+    store.useSpare(&j.block->spare);
+    integrator.planBlock(*j.block, j.ix0, j.iy0, j.box, split, plan);
+  }
+  return integrator.visited();
+}
+
+template <PolicyType P>
+[[gnu::noinline]] std::uint64_t updateParts(WaveletMap::Impl& impl, NodeStore& store,
+                                            const ScanClassifier& cls, const PolicyConsts& pc,
+                                            SplitPlan* plan, std::atomic<std::size_t>* next) {
+  Integrator<P> integrator(impl, store, cls, pc);
+  const std::size_t n = plan->parts.size();
+  for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < n;
+       i = next->fetch_add(1, std::memory_order_relaxed)) {
+    integrator.visitPart(&plan->tasks[plan->parts[i]]);
+  }
+  return integrator.visited();
+}
+
+template <PolicyType P>
+[[gnu::noinline]] void settleBlocks(WaveletMap::Impl& impl, NodeStore& store,
+                                    const ScanClassifier& cls, const PolicyConsts& pc,
+                                    SplitPlan* plan) {
+  Integrator<P> integrator(impl, store, cls, pc);
+  integrator.settle(plan);
+}
+
+/// Gives the spare groups of each block of the plan to its parts of this scan, one by one in
+/// turn (the parts of a block are consecutive in plan->parts), so that groups a block freed
+/// above its parts are used again below them.
+inline void lendSparesToParts(WaveletMap::Impl& impl, SplitPlan* plan) {
+  const std::size_t n = plan->parts.size();
+  for (std::size_t first = 0; first < n;) {
+    Block* b = plan->tasks[plan->parts[first]].block;
+    std::size_t end = first + 1;
+    while (end < n && plan->tasks[plan->parts[end]].block == b) ++end;
+    for (std::size_t i = first; b->spare != 0; i = i + 1 < end ? i + 1 : first) {
+      impl.pool.pushSpare(plan->tasks[plan->parts[i]].spare, impl.pool.popSpare(&b->spare));
+    }
+    first = end;
+  }
 }
 
 // The instantiations compiled apart from integrate.cpp (integrate_ndt.cpp,

@@ -2,7 +2,9 @@
 // prepared and classified by the ScanClassifier (scan_classifier.h); every block within its
 // reach that is not U goes through the quadtree update Integrator<P> (quadtree_update.h), one
 // instantiation per update policy. The touched blocks are found and created first, on the calling
-// thread; with num_threads != 1 they are then updated on the map's worker threads.
+// thread; with num_threads != 1 they are then updated on the map's worker threads. A scan of few
+// blocks (indoors) has its blocks split below their roots, so that the threads share the parts
+// of one block (split_plan.h).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -113,6 +115,78 @@ std::uint64_t updateBlocksFor(WaveletMap::Impl& impl, detail::NodeStore& store,
   return detail::updateBlocks<P, false>(impl, store, cls, pc, ndt, hits, jobs, next);
 }
 
+// The worker threads of `impl` for a scan that has `jobs` pieces of work (made on first use, or
+// again when num_threads changed), and how many of them take part; 1 means the calling thread
+// alone (no pool is made).
+int workersFor(const WaveletMap::Impl& impl, std::size_t jobs,
+               std::unique_ptr<detail::WorkerPool>* workers) {
+  const int threads = std::min(threadsFor(impl.params), static_cast<int>(jobs));
+  if (threads <= 1) return 1;
+  if (!*workers || (*workers)->threads() != threadsFor(impl.params)) {
+    *workers = std::make_unique<detail::WorkerPool>(threadsFor(impl.params));
+  }
+  return threads;
+}
+
+// Per participant of a parallel step: visits and node / group count changes (modulo 2^64), on
+// their own cache lines; added to the map's after the step.
+struct alignas(64) Tally {
+  std::uint64_t visited = 0;
+  std::size_t nodes = 0, groups = 0;
+};
+std::uint64_t addTallies(WaveletMap::Impl& impl, const std::vector<Tally>& tallies) {
+  std::uint64_t visited = 0;
+  for (const Tally& tally : tallies) {
+    visited += tally.visited;
+    impl.nodes += tally.nodes;
+    impl.pool.addLive(tally.groups);
+  }
+  return visited;
+}
+
+// The blocks of `jobs` split below their roots (split_plan.h): their top levels on this thread,
+// their parts on the workers (the nearest to the sensor first), the folding on this thread.
+template <PolicyType P>
+std::uint64_t integrateSplit(WaveletMap::Impl& impl, const ScanClassifier& cls,
+                             const detail::PolicyConsts& pc,
+                             const std::vector<detail::BlockJob>& jobs, int split,
+                             std::unique_ptr<detail::WorkerPool>* workers) {
+  thread_local detail::SplitPlan plan_buffer;  // reused from scan to scan
+  detail::SplitPlan& plan = plan_buffer;        // the workers read this thread's copy
+  plan.clear();
+  detail::NodeStore serial(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
+  std::uint64_t visited = detail::planBlocks<P>(impl, serial, cls, pc, jobs, split, &plan);
+  detail::lendSparesToParts(impl, &plan);
+  std::atomic<std::size_t> next{0};
+  const int threads = workersFor(impl, plan.parts.size(), workers);
+  if (threads <= 1) {
+    visited += detail::updateParts<P>(impl, serial, cls, pc, &plan, &next);
+  } else {
+    const detail::PreparedScan& ps = cls.scan();
+    const auto rank = [&](std::size_t i) {
+      const detail::SplitTask& t = plan.tasks[i];
+      const double half = 0.5 * static_cast<double>(std::int64_t{1} << t.level) * ps.res;
+      const double cx = static_cast<double>(t.ix0) * ps.res + half - ps.px;
+      const double cy = static_cast<double>(t.iy0) * ps.res + half - ps.py;
+      return std::make_pair(t.box.cls == CellClass::kMixed ? 0 : 1, cx * cx + cy * cy);
+    };
+    std::stable_sort(plan.parts.begin(), plan.parts.end(),
+                     [&](std::size_t a, std::size_t b) { return rank(a) < rank(b); });
+    std::vector<Tally> tallies(static_cast<std::size_t>((*workers)->threads()));
+    const auto active = static_cast<std::size_t>(threads);
+    (*workers)->run([&](int t) {
+      const auto tu = static_cast<std::size_t>(t);
+      if (tu >= active) return;
+      Tally& tally = tallies[tu];
+      detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
+      tally.visited = detail::updateParts<P>(impl, store, cls, pc, &plan, &next);
+    });
+    visited += addTallies(impl, tallies);
+  }
+  detail::settleBlocks<P>(impl, serial, cls, pc, &plan);
+  return visited;
+}
+
 // `workers`: the map's worker threads (made here on first use), shared by its reflection layers.
 template <PolicyType P>
 std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, double period,
@@ -188,22 +262,19 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
   // does not depend on which thread updates which block, nor in which order.
   // The chunk table grows here, whatever the thread count, so that its size does not depend on it.
   impl.pool.reserveFresh(jobs.size() * maxGroupsPerBlock(L));
-  const int threads = std::min(threadsFor(p), static_cast<int>(jobs.size()));
+  // Without payloads the blocks of a scan of few blocks are split below their roots, so that
+  // threads share a block (split_plan.h); the same whatever the thread count.
+  const int split = ndt == nullptr && hits == nullptr && jobs.size() <= detail::kSplitMaxBlocks
+                        ? detail::splitLevels(L)
+                        : 0;
+  if (split > 0) return visited + integrateSplit<P>(impl, cls, pc, jobs, split, workers);
   std::atomic<std::size_t> next{0};
+  const int threads = workersFor(impl, jobs.size(), workers);
   if (threads <= 1) {
     detail::NodeStore store(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
     return visited + updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
   }
   orderByWork(ps, block_size, &jobs);
-  if (!*workers || (*workers)->threads() != threadsFor(p)) {
-    *workers = std::make_unique<detail::WorkerPool>(threadsFor(p));
-  }
-  // Per participant: visits and node / group count changes (modulo 2^64), on their own cache
-  // lines.
-  struct alignas(64) Tally {
-    std::uint64_t visited = 0;
-    std::size_t nodes = 0, groups = 0;
-  };
   std::vector<Tally> tallies(static_cast<std::size_t>((*workers)->threads()));
   const auto active = static_cast<std::size_t>(threads);
   (*workers)->run([&](int t) {
@@ -213,12 +284,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
     tally.visited = updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
   });
-  for (const Tally& tally : tallies) {
-    visited += tally.visited;
-    impl.nodes += tally.nodes;
-    impl.pool.addLive(tally.groups);
-  }
-  return visited;
+  return visited + addTallies(impl, tallies);
 }
 
 // One instantiation per policy, in the order of PolicyType's enumerators.

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "update/map_slot.h"
+#include "update/split_plan.h"
 #include "payloads/ndt_update.h"
 #include "payloads/reflection_update.h"
 #include "classify/scan_classifier.h"
@@ -67,6 +68,53 @@ class Integrator {
                       [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
   }
 
+  // The walk of blocks split below their roots (split_plan.h), without payloads.
+
+  /// Step 1 (calling thread; node groups from the block's spares): updates the top `split`
+  /// levels of block b (origin ix0, iy0, classified as `box`) as integrateBlock() would, except
+  /// that the slots `split` levels below the root that must be refined become parts, and every
+  /// refined slot above them waits in `plan` for its children's changes.
+  void planBlock(Block& b, std::int64_t ix0, std::int64_t iy0, const SquareInfo& box, int split,
+                 SplitPlan* plan) {
+    static_assert(!kNdt && !kHits, "the split walk carries no payloads");
+    RootSlot slot(impl_, store_, b);
+    const double s = b.s;
+    b.s += updateSlotWith(slot, box.cls, s, [&](Node* stored) {
+      Node& m = stored != nullptr ? *stored : storeUniform(slot);
+      planNode(m, box, impl_.levels, ix0, iy0, s, split, 0, &b, nullptr, 0, -1, plan);
+      return 0.0;  // settle() adds the change
+    });
+  }
+
+  /// Step 2 (any thread): updates part t (node groups from its own spares).
+  void visitPart(SplitTask* t) {
+    store_.useSpare(t->spare);
+    t->ds = visitNode(*t->node, t->box, t->level, t->ix0, t->iy0, t->s);
+  }
+
+  /// Step 3 (calling thread): children before parents, each waiting slot's changes fold into its
+  /// node (a frame) and the slot is settled as refineSlot() settles it.
+  void settle(SplitPlan* plan) {
+    Block* current = nullptr;
+    for (std::size_t i = plan->tasks.size(); i-- > 0;) {
+      SplitTask& t = plan->tasks[i];
+      if (t.block != current) {
+        current = t.block;
+        store_.useSpare(&current->spare);
+      }
+      if (!t.part) t.ds = foldChanges(*t.node, t.delta);
+      if (t.parent == nullptr) {
+        RootSlot slot(impl_, store_, *t.block);
+        settleSlot(slot, *t.node);
+        t.block->s += t.ds;
+      } else {
+        ChildSlot slot(impl_, store_, *t.parent, t.q);
+        settleSlot(slot, *t.node);
+        plan->tasks[static_cast<std::size_t>(t.up)].delta[static_cast<std::size_t>(t.q)] += t.ds;
+      }
+    }
+  }
+
  private:
   // The rules of one slot of class `cls` whose average is s (U skipped, E at the slot's own
   // scale, the section 3.4 skip); descend(m) updates the slot's node m (the stored one, or a
@@ -76,6 +124,14 @@ class Integrator {
   // the slot's average.
   template <typename Slot, typename Descend>
   [[gnu::always_inline]] double updateSlot(Slot& slot, CellClass cls, double s, Descend descend) {
+    return updateSlotWith(slot, cls, s,
+                          [&](Node* node) { return refineSlot(slot, node, descend); });
+  }
+  // updateSlot() whose refinement is refine(slot's stored node or nullptr): refineSlot() in the
+  // walk, a plan of the slot's update in the split walk.
+  template <typename Slot, typename Refine>
+  [[gnu::always_inline]] double updateSlotWith(Slot& slot, CellClass cls, double s,
+                                               Refine refine) {
     Node* node = slot.node();
     switch (cls) {
       case CellClass::kUnknown:
@@ -106,7 +162,72 @@ class Integrator {
       default:
         break;
     }
-    return refineSlot(slot, node, descend);
+    return refine(node);
+  }
+
+  // The split walk's visitNode(): node m (level l, average s) of a slot to refine, `left` levels
+  // above the parts; `part` numbers the slot among the block's parts so far (2 bits per level);
+  // the slot is the root of b (parent nullptr) or child q of *parent, whose task is `up`.
+  void planNode(Node& m, const SquareInfo& box, int l, std::int64_t ix0, std::int64_t iy0,
+                double s, int left, std::size_t part, Block* b, Node* parent, int q, long up,
+                SplitPlan* plan) {
+    const auto self = static_cast<long>(plan->tasks.size());
+    SplitTask t;
+    t.block = b;
+    t.parent = parent;
+    t.q = q;
+    t.node = &m;
+    t.up = up;
+    if (left == 0) {
+      t.part = true;
+      t.box = box;
+      t.level = l;
+      t.ix0 = ix0;
+      t.iy0 = iy0;
+      t.s = s;
+      t.spare = &b->part_spare[part];
+      plan->tasks.push_back(t);
+      plan->parts.push_back(static_cast<std::size_t>(self));
+      return;
+    }
+    plan->tasks.push_back(t);
+    ++visited_;
+    impl_.flush(m);
+    const std::array<double, 4> c = haar::backward(s, m.d);
+    std::array<double, 4> delta{};
+    const std::int64_t half = std::int64_t{1} << (l - 1);
+    for (int cq = 0; cq < 4; ++cq) {
+      const auto qu = static_cast<std::size_t>(cq);
+      const std::int64_t cx = ix0 + ((cq & 1) ? half : 0), cy = iy0 + ((cq & 2) ? half : 0);
+      const SquareInfo child_box = cls_.classifySquare(l - 1, cx, cy, box);
+      ++visited_;
+      if (child_box.cls == CellClass::kUnknown) continue;
+      ChildSlot slot(impl_, store_, m, cq);
+      delta[qu] = updateSlotWith(slot, child_box.cls, c[qu], [&](Node* stored) {
+        Node& cm = stored != nullptr ? *stored : storeUniform(slot);
+        planNode(cm, child_box, l - 1, cx, cy, c[qu], left - 1, part * 4 + qu, b, &m, cq, self,
+                 plan);
+        return 0.0;  // settle() adds the change
+      });
+    }
+    plan->tasks[static_cast<std::size_t>(self)].delta = delta;
+  }
+
+  // Stores a uniform node with the knowledge of `slot` (the temporary of refineSlot) in it.
+  template <typename Slot>
+  Node& storeUniform(Slot& slot) {
+    Node tmp{};
+    tmp.known_all = slot.knownAll() ? 0xF : 0;
+    tmp.known_any = slot.knownAny() ? 0xF : 0;
+    slot.install(tmp);
+    return *slot.node();
+  }
+
+  // refineSlot()'s end for a stored node m: the slot takes m's knowledge; a trivial m goes.
+  template <typename Slot>
+  void settleSlot(Slot& slot, const Node& m) {
+    slot.setKnown(m.known_all == 0xF, m.known_any != 0);
+    if (impl_.isTrivial(m)) slot.remove();
   }
 
   // kNdt: the next slot to update spans `sp`, inside the square classified as `box`.
