@@ -26,7 +26,7 @@
 
 #include "input_status.h"
 #include "map_publisher.h"
-#include "pose_check.h"
+#include "wavog_mapping/ros/pose_check.h"
 #include "reconfigure.h"
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"

@@ -1,5 +1,5 @@
 // The laser-speed check of scan poses (see pose_check.h).
-#include "pose_check.h"
+#include "wavog_mapping/ros/pose_check.h"
 
 #include <cmath>
 #include <sstream>

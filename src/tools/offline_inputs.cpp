@@ -31,6 +31,7 @@
 #include "wavog_mapping/core/scan_period.h"
 #include "wavog_mapping/io/carmen_reader.h"
 #include "wavog_mapping/ros/conversions.h"
+#include "wavog_mapping/ros/pose_check.h"
 #include "wavog_mapping/ros/scan_placement.h"
 
 namespace wavog_offline {
@@ -140,6 +141,11 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   std::map<std::string, wavog::ScanPeriod> periods;  // per topic, for forget_half_life
   std::set<std::string> slash_warned;                // topics whose frame_id had a leading '/'
   wavog::MotionCompensator compensator;
+  // As the node: a scan whose laser would move faster than a vehicle is refused (a corrupt
+  // odometry sample), the first refusal's reason goes to the warnings.
+  wavog_ros::PoseCheck poses;
+  std::size_t absurd_poses = 0;
+  std::string first_absurd;
   wavog_ros::PlacementOptions placement_options;
   placement_options.fixed_frame = info.fixed_frame;
   placement_options.motion_compensation = config.ros.motion_compensation;
@@ -173,6 +179,16 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
                                                                        : "tf_unavailable");
       continue;
     }
+    const double first_beam = scan->header.stamp.toSec();
+    const double last_beam =
+        first_beam + (placement.compensate ? wavog_ros::sweepSeconds(*scan) : 0.0);
+    const std::string absurd =
+        poses.check(frame, placement.start, first_beam, placement.end, last_beam);
+    if (!absurd.empty()) {
+      if (absurd_poses++ == 0) first_absurd = absurd;
+      s.skip("absurd_pose");
+      continue;
+    }
     info.motion_fallbacks += placement.motion_fallback ? 1 : 0;
     info.motion_compensated += placement.compensate ? 1 : 0;
     wavog::Pose2 pose;
@@ -181,6 +197,10 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
     s.integrate(pose, view, scan->header.stamp.toSec());
   }
   s.finish();
+  if (absurd_poses > 0) {
+    info.warnings.push_back(std::to_string(absurd_poses) +
+                            " scans refused for an absurd pose from tf, the first: " + first_absurd);
+  }
   if (s.integrated() == 0 && !first_tf_error.empty()) {
     std::vector<std::string> frames;
     tf._getFrameStrings(frames);

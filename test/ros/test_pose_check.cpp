@@ -1,12 +1,12 @@
-// PoseCheck (src/ros/pose_check.h): absurd laser poses from tf (the oko bag's odometry jumps to
-// 1e22-1e32 m and -2.8e7 m for one sample and back) are refused, against the last accepted scan
-// and over a sweep; mapping goes on at the next sane pose; a real jump is accepted once a second
-// scan confirms it. No master needed.
+// PoseCheck (include/wavog_mapping/ros/pose_check.h): absurd laser poses from tf (the oko bag's
+// odometry jumps to 1e22-1e32 m and -2.8e7 m for one sample and back) are refused, against the
+// last accepted scan and over a sweep; mapping goes on at the next sane pose; a real jump is
+// accepted once a second scan confirms it. No master needed.
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "../../src/ros/pose_check.h"
+#include "wavog_mapping/ros/pose_check.h"
 
 namespace {
 

@@ -412,6 +412,43 @@ TEST(Offline, UpsideDownLaserAndMotionCompensationInABag) {
   EXPECT_LT(mirror, -1.5f);
 }
 
+TEST(Offline, AbsurdPoseFromTfIsRefusedAsTheNodeRefusesIt) {
+  // The drive of the test above, but one odometry sample (at 0.51 s) jumps 2 km ahead and back, as
+  // the oko bag's odometry does: scan 5 (0.505-0.523 s) starts between it and a sane sample, so tf
+  // places it 1 km away. The node refuses such a scan (pose_check.h); so does wavog_offline, and
+  // its map stays where the robot drove.
+  namespace dl = driving_laser;
+  const std::string bag_path = (workDir() / "jump.bag").string();
+  {
+    rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
+    tf2_msgs::TFMessage statics;
+    statics.transforms.push_back(dl::mount("laser_down"));
+    bag.write("/tf_static", dl::kT0, statics);
+    for (auto t : dl::drive()) {
+      if (t.header.stamp == dl::kT0 + ros::Duration(0.51)) t.transform.translation.x = 2000.0;
+      tf2_msgs::TFMessage tf;
+      tf.transforms.push_back(t);
+      bag.write("/tf", t.header.stamp, tf);
+    }
+    for (int i = 0; i < dl::kScans; ++i) {
+      const sensor_msgs::LaserScan s = dl::scanAt(dl::scanTime(i), "laser_down");
+      bag.write("/scan", s.header.stamp, s);
+    }
+  }
+  const std::string out = (workDir() / "jump").string();
+  const RunResult r = run(WAVOG_OFFLINE, "--no-progress -o " + out + " " + bag_path);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json json = readJson(fs::path(out) / "summary.json");
+  EXPECT_EQ(json["scans_integrated"], 19) << json;
+  EXPECT_EQ(json["dropped_by_reason"]["absurd_pose"], 1) << json;
+  EXPECT_NE(r.err.find("absurd pose"), std::string::npos) << r.err;
+  wavog::WaveletMap offline(defaultParams());
+  offline.load((fs::path(out) / "map.wavog").string());
+  wavog::CellBox box;
+  ASSERT_TRUE(offline.bounds(0, &box));
+  EXPECT_LT(static_cast<double>(box.max_x) * offline.resolution(), 100.0);  // not 1 km away
+}
+
 TEST(Offline, TruncatedGzipLogIsReportedAfterMappingWhatWasRead) {
   const std::string whole = wavog_test::gzipDeflate(wavog_test::syntheticFlaserLog(400));
   const std::string bytes = whole.substr(0, whole.size() / 2);  // about 200 scans

@@ -5,10 +5,10 @@
 // laser does not move faster than kMaxSensorSpeed: a scan whose pose implies more, against the
 // last accepted scan of the same input and frame or between the first and last beam of its sweep,
 // is refused. A real jump (a relocalisation, a restarted odometry) is confirmed by the next scan
-// agreeing with the refused one, and mapping goes on from there. Plain values: the caller
-// (MappingRos) guards a PoseCheck with its lock; no ROS types.
-#ifndef WAVOG_MAPPING_SRC_ROS_POSE_CHECK_H_
-#define WAVOG_MAPPING_SRC_ROS_POSE_CHECK_H_
+// agreeing with the refused one, and mapping goes on from there. Plain values: the callers are
+// MappingRos (which guards a PoseCheck with its lock) and wavog_offline's bag input; no ROS types.
+#ifndef WAVOG_MAPPING_ROS_POSE_CHECK_H_
+#define WAVOG_MAPPING_ROS_POSE_CHECK_H_
 
 #include <map>
 #include <string>
@@ -56,4 +56,4 @@ class PoseCheck {
 
 }  // namespace wavog_ros
 
-#endif  // WAVOG_MAPPING_SRC_ROS_POSE_CHECK_H_
+#endif  // WAVOG_MAPPING_ROS_POSE_CHECK_H_
