@@ -54,3 +54,14 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node
   add_dependencies(test_fleet_system ${PROJECT_NAME}_generate_messages_cpp wavog_mapping_node
                    wavog_fleet wavog_fleet_nodelet wavog_fleet_test_bag)
 endif()
+
+# ---- The fleet map as a nodelet (test/fleet_nodelet.test): placed scans from the test itself ------
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet_nodelet)
+  find_package(rostest REQUIRED)
+  add_rostest_gtest(test_fleet_nodelet test/fleet_nodelet.test test/ros/test_fleet_nodelet.cpp)
+  target_include_directories(test_fleet_nodelet SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
+  target_link_libraries(test_fleet_nodelet wavog_ros_config wavog_core ${catkin_LIBRARIES}
+                        ${GTEST_LIBRARIES})
+  target_compile_definitions(test_fleet_nodelet PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  add_dependencies(test_fleet_nodelet ${PROJECT_NAME}_generate_messages_cpp wavog_fleet_nodelet)
+endif()
