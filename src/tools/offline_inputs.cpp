@@ -199,7 +199,8 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   s.finish();
   if (absurd_poses > 0) {
     info.warnings.push_back(std::to_string(absurd_poses) +
-                            " scans refused for an absurd pose from tf, the first: " + first_absurd);
+                            " scans refused for an absurd pose from tf, the first: " +
+                            first_absurd);
   }
   if (s.integrated() == 0 && !first_tf_error.empty()) {
     std::vector<std::string> frames;

@@ -226,7 +226,8 @@ class WaveletMap {
   /// Counts; `count_observed` also walks the tree to count observed cells (O(nodes)).
   MapStats stats(bool count_observed = false) const;
 
-  /// Opaque storage, defined in src/core/storage/map_impl.h (named here so the core's sources can use it).
+  /// Opaque storage, defined in src/core/storage/map_impl.h (named here so the core's sources
+  /// can use it).
   struct Impl;
 
  private:
