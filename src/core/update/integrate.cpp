@@ -128,13 +128,25 @@ int workersFor(const WaveletMap::Impl& impl, std::size_t jobs,
   return threads;
 }
 
-// Per participant of a parallel step: visits and node / group count changes (modulo 2^64), on
-// their own cache lines; added to the map's after the step.
-struct alignas(64) Tally {
-  std::uint64_t visited = 0;
-  std::size_t nodes = 0, groups = 0;
-};
-std::uint64_t addTallies(WaveletMap::Impl& impl, const std::vector<Tally>& tallies) {
+// Runs work(store) on `threads` of the workers, each with a NodeStore counting into its own tally
+// (visits and node / group count changes, modulo 2^64, on their own cache lines), added to the
+// map's afterwards; work returns the nodes it visited. Returns the visits of all.
+template <typename Work>
+std::uint64_t runOnWorkers(WaveletMap::Impl& impl, detail::WorkerPool& workers, int threads,
+                           Work work) {
+  struct alignas(64) Tally {
+    std::uint64_t visited = 0;
+    std::size_t nodes = 0, groups = 0;
+  };
+  std::vector<Tally> tallies(static_cast<std::size_t>(workers.threads()));
+  const auto active = static_cast<std::size_t>(threads);
+  workers.run([&](int t) {
+    const auto tu = static_cast<std::size_t>(t);
+    if (tu >= active) return;
+    Tally& tally = tallies[tu];
+    detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
+    tally.visited = work(store);
+  });
   std::uint64_t visited = 0;
   for (const Tally& tally : tallies) {
     visited += tally.visited;
@@ -172,16 +184,9 @@ std::uint64_t integrateSplit(WaveletMap::Impl& impl, const ScanClassifier& cls,
     };
     std::stable_sort(plan.parts.begin(), plan.parts.end(),
                      [&](std::size_t a, std::size_t b) { return rank(a) < rank(b); });
-    std::vector<Tally> tallies(static_cast<std::size_t>((*workers)->threads()));
-    const auto active = static_cast<std::size_t>(threads);
-    (*workers)->run([&](int t) {
-      const auto tu = static_cast<std::size_t>(t);
-      if (tu >= active) return;
-      Tally& tally = tallies[tu];
-      detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
-      tally.visited = detail::updateParts<P>(impl, store, cls, pc, &plan, &next);
+    visited += runOnWorkers(impl, **workers, threads, [&](detail::NodeStore& store) {
+      return detail::updateParts<P>(impl, store, cls, pc, &plan, &next);
     });
-    visited += addTallies(impl, tallies);
   }
   detail::settleBlocks<P>(impl, serial, cls, pc, &plan);
   return visited;
@@ -275,16 +280,9 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
     return visited + updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
   }
   orderByWork(ps, block_size, &jobs);
-  std::vector<Tally> tallies(static_cast<std::size_t>((*workers)->threads()));
-  const auto active = static_cast<std::size_t>(threads);
-  (*workers)->run([&](int t) {
-    const auto tu = static_cast<std::size_t>(t);
-    if (tu >= active) return;
-    Tally& tally = tallies[tu];
-    detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
-    tally.visited = updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
-  });
-  return visited + addTallies(impl, tallies);
+  return visited + runOnWorkers(impl, **workers, threads, [&](detail::NodeStore& store) {
+           return updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
+         });
 }
 
 // One instantiation per policy, in the order of PolicyType's enumerators.
