@@ -34,6 +34,14 @@ std::vector<char> readAll(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
+/// Appends the file's CRC-32 of `bytes` (a map file without its last 4 bytes).
+void appendCrc(std::vector<char>* bytes) {
+  const auto crc = static_cast<std::uint32_t>(::crc32(
+      0L, reinterpret_cast<const Bytef*>(bytes->data()), static_cast<uInt>(bytes->size())));
+  const auto* c = reinterpret_cast<const char*>(&crc);
+  bytes->insert(bytes->end(), c, c + sizeof(crc));
+}
+
 void writeAll(const std::string& path, const std::vector<char>& data) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(data.data(), static_cast<std::streamsize>(data.size()));
@@ -265,10 +273,7 @@ TEST(MapIo, FileSizeIsBoundByTheHeadersBlockCount) {
     std::vector<char> out(bytes.begin(), bytes.end() - 4);
     std::memcpy(out.data() + kCountAt, &count, sizeof(count));
     out.resize(out.size() + extra, '\0');
-    const auto crc = static_cast<std::uint32_t>(
-        ::crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
-    const auto* c = reinterpret_cast<const char*>(&crc);
-    out.insert(out.end(), c, c + 4);
+    appendCrc(&out);
     return out;
   };
   WaveletMap target(params());
@@ -305,10 +310,7 @@ TEST(MapIo, LogOddsTheUpdateCannotCarryAreRefused) {
   const auto patched = [&](std::size_t at, const void* value, std::size_t size) {
     std::vector<char> out(bytes.begin(), bytes.end() - 4);
     std::memcpy(out.data() + at, value, size);
-    const auto crc = static_cast<std::uint32_t>(
-        ::crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
-    const auto* c = reinterpret_cast<const char*>(&crc);
-    out.insert(out.end(), c, c + 4);
+    appendCrc(&out);
     return out;
   };
   RandomScans scans(12, 12.0);
@@ -402,10 +404,7 @@ std::vector<char> fileWithBlocks(const MapParams& p, std::uint64_t count,
   out.insert(out.end(), c, c + sizeof(count));
   out.insert(out.end(), blocks.begin(), blocks.end());
   out.insert(out.end(), empty.begin() + kCountAt + 8, empty.end() - 4);
-  const auto crc = static_cast<std::uint32_t>(
-      ::crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
-  const auto* k = reinterpret_cast<const char*>(&crc);
-  out.insert(out.end(), k, k + 4);
+  appendCrc(&out);
   return out;
 }
 
@@ -533,10 +532,7 @@ TEST(MapIo, ReflectionPointQueryAgreesWithReadOutAtLargeLogOdds) {
   const float detail = 5.44e15f;  // block 0's root dy
   std::memcpy(bytes.data() + kFlagsAt + 1 + 4, &detail, sizeof(detail));
   bytes.resize(bytes.size() - 4);
-  const auto crc = static_cast<std::uint32_t>(
-      ::crc32(0L, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
-  const auto* c = reinterpret_cast<const char*>(&crc);
-  bytes.insert(bytes.end(), c, c + 4);
+  appendCrc(&bytes);
   writeAll(path, bytes);
   WaveletMap map(p);
   ASSERT_NO_THROW(map.load(path));
@@ -587,10 +583,7 @@ TEST(MapIo, ReflectionPairsSurviveARoundTripAtLargeLogOdds) {
       constexpr std::size_t kAverageAt = 8 + 4 + 8 + 4 + 8 + 8 + 8 + 4 + 4;  // block 0's average
       std::memcpy(bytes.data() + kAverageAt, &average, sizeof(average));
       bytes.resize(bytes.size() - 4);
-      const auto crc = static_cast<std::uint32_t>(::crc32(
-          0L, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
-      const auto* c = reinterpret_cast<const char*>(&crc);
-      bytes.insert(bytes.end(), c, c + 4);
+      appendCrc(&bytes);
       writeAll(path, bytes);
       WaveletMap map(p);
       ASSERT_NO_THROW(map.load(path));
@@ -635,10 +628,7 @@ TEST(MapIo, ReflectionModeThePolicyNeverKeepsIsRefused) {
     const auto* v = reinterpret_cast<const char*>(&version);
     out.insert(out.end(), v, v + sizeof(version));
     out.insert(out.end(), body.begin() + 1, body.end());
-    const auto crc = static_cast<std::uint32_t>(
-        ::crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())));
-    const auto* c = reinterpret_cast<const char*>(&crc);
-    out.insert(out.end(), c, c + sizeof(crc));
+    appendCrc(&out);
     return out;
   };
   MapParams p = MapParams::defaultsFor(wavog::PolicyType::kClamp);

@@ -11,9 +11,9 @@
 #include <sensor_msgs/LaserScan.h>
 
 #include <cstdint>
-#include <mutex>
 #include <string>
 
+#include "mapper_listener.h"
 #include "wavog_mapping/MapperStatus.h"
 
 namespace {
@@ -21,20 +21,6 @@ namespace {
 constexpr double kWaitSeconds = 90.0;   // wall time for the bag (36 s at 4x) and the end flush
 constexpr int kOccupied = 65;           // map_server's occupied threshold (0..100)
 constexpr int kFree = 25;               // and its free threshold
-
-std::mutex g_mutex;
-wavog_mapping::MapperStatus::ConstPtr g_status;
-nav_msgs::OccupancyGrid::ConstPtr g_map;
-
-void onStatus(const wavog_mapping::MapperStatus::ConstPtr& s) {
-  std::lock_guard<std::mutex> lock(g_mutex);
-  g_status = s;
-}
-
-void onMap(const nav_msgs::OccupancyGrid::ConstPtr& m) {
-  std::lock_guard<std::mutex> lock(g_mutex);
-  g_map = m;
-}
 
 struct BagFacts {
   std::uint64_t scans = 0;
@@ -67,18 +53,14 @@ TEST(RealBag, EveryScanOfASlashFrameBagWithoutTfIsMapped) {
   ASSERT_EQ(bag.slashed, bag.scans);
   ASSERT_EQ(bag.tf, 0u);
 
-  ros::Subscriber status_sub = nh.subscribe("/wavog_mapping/status", 10, onStatus);
-  ros::Subscriber map_sub = nh.subscribe("/map", 1, onMap);
+  const wavog_test::MapperListener mapper(nh);
   ros::AsyncSpinner spinner(1);
   spinner.start();
 
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kWaitSeconds);
   wavog_mapping::InputStatus input;
   while (ros::ok() && ros::WallTime::now() < deadline) {
-    {
-      std::lock_guard<std::mutex> lock(g_mutex);
-      if (g_status && !g_status->inputs.empty()) input = g_status->inputs[0];
-    }
+    mapper.firstInput(&input);
     if (input.integrated >= bag.scans) break;
     ros::WallDuration(0.1).sleep();
   }
@@ -92,10 +74,7 @@ TEST(RealBag, EveryScanOfASlashFrameBagWithoutTfIsMapped) {
   nav_msgs::OccupancyGrid::ConstPtr map;
   const ros::WallTime map_deadline = ros::WallTime::now() + ros::WallDuration(20.0);
   while (ros::ok() && ros::WallTime::now() < map_deadline) {
-    {
-      std::lock_guard<std::mutex> lock(g_mutex);
-      map = g_map;
-    }
+    map = mapper.map();
     if (map && map->header.stamp >= input.last_stamp) break;
     ros::WallDuration(0.1).sleep();
   }

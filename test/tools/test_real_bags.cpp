@@ -31,26 +31,13 @@
 #include <string>
 #include <vector>
 
+#include "mapper_listener.h"
 #include "wavog_mapping/MapperStatus.h"
 
 namespace {
 
 constexpr double kWaitSeconds = 150.0;  // wall time for the bag and the end flush
 constexpr int kOccupied = 65;           // map_server's occupied threshold (0..100)
-
-std::mutex g_mutex;
-wavog_mapping::MapperStatus::ConstPtr g_status;
-nav_msgs::OccupancyGrid::ConstPtr g_map;
-
-void onStatus(const wavog_mapping::MapperStatus::ConstPtr& s) {
-  std::lock_guard<std::mutex> lock(g_mutex);
-  g_status = s;
-}
-
-void onMap(const nav_msgs::OccupancyGrid::ConstPtr& m) {
-  std::lock_guard<std::mutex> lock(g_mutex);
-  g_map = m;
-}
 
 struct BagFacts {
   std::uint64_t scans = 0;
@@ -139,8 +126,7 @@ TEST(RealBags, MappedAsTheReadmeSays) {
   ASSERT_GT(bag.scans, 100u);
   const int min_integrated = pnh.param("min_integrated", 0);
 
-  ros::Subscriber status_sub = nh.subscribe("/wavog_mapping/status", 10, onStatus);
-  ros::Subscriber map_sub = nh.subscribe("/map", 1, onMap);
+  wavog_test::MapperListener mapper(nh);
   ros::AsyncSpinner spinner(1);
   spinner.start();
 
@@ -152,10 +138,7 @@ TEST(RealBags, MappedAsTheReadmeSays) {
   std::uint64_t last_accounted = 0;
   ros::WallTime last_change = ros::WallTime::now();
   while (ros::ok() && ros::WallTime::now() < deadline) {
-    {
-      std::lock_guard<std::mutex> lock(g_mutex);
-      if (g_status && !g_status->inputs.empty()) input = g_status->inputs[0];
-    }
+    mapper.firstInput(&input);
     const std::uint64_t accounted = input.received + input.integrated;
     if (accounted != last_accounted) {
       last_accounted = accounted;
@@ -193,11 +176,7 @@ TEST(RealBags, MappedAsTheReadmeSays) {
     EXPECT_EQ(input.dropped_absurd_pose, 0u) << input;
   }
 
-  nav_msgs::OccupancyGrid::ConstPtr map;
-  {
-    std::lock_guard<std::mutex> lock(g_mutex);
-    map = g_map;
-  }
+  const nav_msgs::OccupancyGrid::ConstPtr map = mapper.map();
   ASSERT_TRUE(map != nullptr) << "no /map received";
   const double width_m = map->info.width * map->info.resolution;
   const double height_m = map->info.height * map->info.resolution;
@@ -220,7 +199,7 @@ TEST(RealBags, MappedAsTheReadmeSays) {
   if (pnh.param("status_after_end", false)) {
     // As `rostopic echo -n 1 /wavog_mapping/status` after the bag: a new subscriber, the bag's
     // clock stopped, receives the latched status at once, with the final counters.
-    status_sub.shutdown();
+    mapper.stopStatus();
     std::mutex m;
     wavog_mapping::MapperStatus::ConstPtr late;
     ros::NodeHandle late_nh;
