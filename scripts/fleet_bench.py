@@ -15,12 +15,11 @@ Writes OUT/bench.md and OUT/bench.json. usage: fleet_bench.py BIN_DIR SOURCE_DIR
 """
 import json
 import os
-import signal
 import subprocess
 import sys
 import time
 
-from fleet_common import free_port, cpu_seconds
+from fleet_common import cpu_seconds, free_port, stop_all, wait_for_master
 
 BIN, SRC, OUT = sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3])
 DURATION = float(sys.argv[4]) if len(sys.argv) > 4 else 20.0
@@ -41,13 +40,7 @@ class Graph:
         self.procs = []
         self.start(["roscore", "-p", self.env["ROS_MASTER_URI"].rsplit(":", 1)[1]])
         os.environ.update(self.env)
-        import rosgraph
-        for _ in range(100):
-            try:
-                rosgraph.Master("/fleet_bench").getPid()
-                break
-            except Exception:
-                time.sleep(0.2)
+        wait_for_master("/fleet_bench")
         self.param("set", "/use_sim_time", "true")
 
     def param(self, *args):
@@ -74,12 +67,7 @@ class Graph:
         raise RuntimeError("no " + topic_or_service)
 
     def stop(self, p):
-        p.send_signal(signal.SIGINT)
-        try:
-            p.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            p.wait()
+        stop_all([p])
 
     def close(self):
         for p in reversed(self.procs):

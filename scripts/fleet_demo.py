@@ -13,13 +13,12 @@ usage: fleet_demo.py BIN_DIR SOURCE_DIR OUT [DURATION]
 """
 import json
 import os
-import signal
 import struct
 import subprocess
 import sys
 import time
 
-from fleet_common import free_port, cpu_seconds
+from fleet_common import cpu_seconds, free_port, stop_all, wait_for_master
 
 BIN, SRC, OUT = sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3])
 DURATION = float(sys.argv[4]) if len(sys.argv) > 4 else 30.0
@@ -50,13 +49,7 @@ def main():
     try:
         port = env["ROS_MASTER_URI"].rsplit(":", 1)[1]
         start(["roscore", "-p", port])
-        import rosgraph
-        for _ in range(100):
-            try:
-                rosgraph.Master("/fleet_demo").getPid()
-                break
-            except Exception:
-                time.sleep(0.2)
+        wait_for_master("/fleet_demo")
         subprocess.run(["rosparam", "set", "/use_sim_time", "true"], env=env, check=True)
         subprocess.run(["rosparam", "load", os.path.join(SRC, "config/fleet.yaml"), "/wavog_fleet"],
                        env=env, check=True)
@@ -125,13 +118,7 @@ def main():
                 raise RuntimeError(service + ": " + r.message)
         status = last["status"]
     finally:
-        for p in reversed(procs):
-            p.send_signal(signal.SIGINT)
-        for p in reversed(procs):
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
+        stop_all(procs)
 
     print("fleet-demo: [4/5] design (b) measured: each vehicle's changed map blocks every 0.5 s "
           "(one more playback)", flush=True)

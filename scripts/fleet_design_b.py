@@ -16,13 +16,12 @@ usage: fleet_design_b.py BIN_DIR SOURCE_DIR OUT BAG [VEHICLES (comma-separated)]
 import json
 import os
 import shutil
-import signal
 import struct
 import subprocess
 import sys
 import time
 
-from fleet_common import free_port
+from fleet_common import free_port, stop_all, wait_for_master
 
 BIN, SRC, OUT, BAG = sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4]
 VEHICLES = (sys.argv[5] if len(sys.argv) > 5 else "v1").split(",")
@@ -82,13 +81,7 @@ def record_snapshots(snap_dir):
     snaps = []
     try:
         start(["roscore", "-p", env["ROS_MASTER_URI"].rsplit(":", 1)[1]])
-        import rosgraph
-        for _ in range(100):
-            try:
-                rosgraph.Master("/fleet_design_b").getPid()
-                break
-            except Exception:
-                time.sleep(0.2)
+        wait_for_master("/fleet_design_b")
         param("set", "/use_sim_time", "true")
         for v in VEHICLES:
             ns = "/%s/wavog_mapping" % v
@@ -130,13 +123,7 @@ def record_snapshots(snap_dir):
         time.sleep(1.0)
         save(k)
     finally:
-        for p in reversed(procs):
-            p.send_signal(signal.SIGINT)
-        for p in reversed(procs):
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
+        stop_all(procs)
     return snaps
 
 
