@@ -61,6 +61,22 @@ std::vector<int> parseScales(const std::string& text) {
   return scales;
 }
 
+/// --laser-pose: six numbers separated by spaces (or commas), each read whole.
+std::vector<double> parseLaserPose(const std::string& text) {
+  std::string spaced = text;
+  std::replace(spaced.begin(), spaced.end(), ',', ' ');
+  std::istringstream in(spaced);
+  std::vector<double> pose;
+  for (std::string item; in >> item;) {
+    pose.push_back(wavog_tools::parseNumber("--laser-pose", item.c_str()));
+  }
+  if (pose.size() != 6) {
+    throw std::invalid_argument("--laser-pose: 6 numbers \"x y z yaw pitch roll\" (m, rad), not '" +
+                                text + "'");
+  }
+  return pose;
+}
+
 /// What --help says first.
 constexpr const char* kDescription =
     "Maps INPUT, a rosbag (LaserScan + /tf, /tf_static) or a CARMEN log (plain or .gz), without "
@@ -93,6 +109,13 @@ void addOptions(CLI::App* app, Options* o) {
       "--fixed-frame", [o](const std::string& v) { o->fixed_frame = wavog_tools::stripSlash(v); },
       "map frame (default: the YAML's map_frame); give the scan's own frame to map a bag "
       "without tf with the laser held fixed");
+  app->add_option_function<std::string>(
+      "--laser-parent", [o](const std::string& v) { o->laser_parent = wavog_tools::stripSlash(v); },
+      "for a bag whose tf lacks the laser: hold each scan frame at --laser-pose in this frame "
+      "(e.g. base_link), as the launch's laser_parent does");
+  app->add_option_function<std::string>(
+      "--laser-pose", [o](const std::string& v) { o->laser_pose = parseLaserPose(v); },
+      "the scan frame in --laser-parent: \"x y z yaw pitch roll\" (m, rad; default 0 0 0 0 0 0)");
   wavog_tools::addNumber(app, "--snapshot-every", &o->snapshot_every,
                          "also write snapshots/t<seconds>_s<scale>.png every S s of log time "
                          "(0: none)");
@@ -242,6 +265,7 @@ Json describeRun(const Options& o, const wavog_ros::Config& config, const InputI
   j["resolution_m"] = config.map.grid.resolution;
   j["aggregation"] = wavog_ros::toString(config.ros.scale_aggregation);
   j["fixed_frame"] = info.fixed_frame;
+  j["laser_mount"] = info.laser_mount.empty() ? Json() : Json(info.laser_mount);
   j["topics"] = info.topics;
   j["scans_integrated"] = s.integrated();
   j["scans_dropped"] = s.droppedTotal();
@@ -293,6 +317,9 @@ Json summaryOf(const Options& o, const wavog_ros::Config& config, const InputInf
 /// range, the output folder made.
 wavog_ros::Config prepare(const Options& o) {
   if (!(o.snapshot_every >= 0.0)) throw std::invalid_argument("--snapshot-every must be >= 0");
+  if (!o.laser_pose.empty() && o.laser_parent.empty()) {
+    throw std::invalid_argument("--laser-pose needs --laser-parent (the frame it is given in)");
+  }
   if (fs::is_directory(o.input))
     throw std::runtime_error(o.input + ": cannot open: is a directory");
   if (!std::ifstream(o.input, std::ios::binary)) {

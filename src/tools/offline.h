@@ -34,6 +34,10 @@ struct Options {
   std::size_t max_scans = 0;
   std::vector<std::string> topics;
   std::string fixed_frame;
+  /// --laser-parent / --laser-pose: the scan frames held at laser_pose (x y z yaw pitch roll, m
+  /// and rad) in laser_parent, for a bag whose tf lacks the laser (as the launch's arguments).
+  std::string laser_parent;
+  std::vector<double> laser_pose;
   double snapshot_every = 0.0;
   bool progress = true;
   bool quiet = false;
@@ -151,6 +155,7 @@ struct InputInfo {
   std::string type;  // "bag" or "carmen"
   std::vector<std::string> topics;
   std::string fixed_frame;
+  std::string laser_mount;  // "<parent> <- <frames>: x y z yaw pitch roll", with --laser-parent
   std::string read_error;
   std::vector<std::string> warnings;
   std::size_t motion_compensated =

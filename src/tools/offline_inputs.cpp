@@ -3,6 +3,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/LaserScan.h>
+#include <tf2/LinearMath/Quaternion.h>
 #include <tf2/buffer_core.h>
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
@@ -54,6 +55,25 @@ std::string describeBagTopics(const rosbag::Bag& bag) {
     s << "\n  " << topic << " (" << info.first << ", " << info.second << " msgs)";
   }
   return topics.empty() ? std::string("\n  (no topics)") : s.str();
+}
+
+// --laser-parent / --laser-pose: the transform laser_parent <- frame, static (valid at any time).
+geometry_msgs::TransformStamped laserMount(const Options& o, const std::string& frame) {
+  std::vector<double> v = o.laser_pose;
+  if (v.empty()) v.assign(6, 0.0);
+  geometry_msgs::TransformStamped t;
+  t.header.frame_id = o.laser_parent;
+  t.child_frame_id = frame;
+  t.transform.translation.x = v[0];
+  t.transform.translation.y = v[1];
+  t.transform.translation.z = v[2];
+  tf2::Quaternion q;
+  q.setRPY(v[5], v[4], v[3]);  // roll, pitch, yaw
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  t.transform.rotation.w = q.w();
+  return t;
 }
 
 std::string normaliseTopic(const std::string& t) { return t.empty() || t[0] == '/' ? t : "/" + t; }
@@ -120,6 +140,7 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   const double duration =
       (tf_view.size() > 0) ? (tf_view.getEndTime() - tf_view.getBeginTime()).toSec() : 0.0;
   tf2::BufferCore tf(ros::Duration(duration + kTfCacheMargin));
+  std::map<std::string, std::string> bag_parents;  // child frame -> its parent in the bag's tf
   for (const rosbag::MessageInstance& m : tf_view) {
     const auto msg = m.instantiate<tf2_msgs::TFMessage>();
     if (!msg) continue;
@@ -127,9 +148,11 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
     for (geometry_msgs::TransformStamped t : msg->transforms) {
       t.header.frame_id = wavog_tools::stripSlash(t.header.frame_id);
       t.child_frame_id = wavog_tools::stripSlash(t.child_frame_id);
+      bag_parents.emplace(t.child_frame_id, t.header.frame_id);
       tf.setTransform(t, "bag", is_static);
     }
   }
+  std::set<std::string> mounted;  // scan frames held at --laser-pose
 
   rosbag::View scans(bag, rosbag::TopicQuery(info.topics));
   std::size_t total = scans.size();
@@ -165,6 +188,20 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
     }
     const std::string& frame = scan->header.frame_id;
     scan_frames.insert(frame);
+    if (!o.laser_parent.empty() && !frame.empty() && mounted.insert(frame).second) {
+      const auto placed = bag_parents.find(frame);
+      if (placed != bag_parents.end()) {
+        throw std::runtime_error(o.input + ": the bag's tf already places the scan frame '" +
+                                 frame + "' in '" + placed->second +
+                                 "': drop --laser-parent / --laser-pose");
+      }
+      if (frame == o.laser_parent) {
+        throw std::runtime_error("--laser-parent '" + o.laser_parent +
+                                 "' is the scan frame itself: give the frame the laser is "
+                                 "mounted on (e.g. base_link)");
+      }
+      tf.setTransform(laserMount(o, frame), "--laser-pose", true);
+    }
     wavog_ros::DropReason reason = wavog_ros::DropReason::kEmpty;
     if (!wavog_ros::checkScan(*scan, &reason)) {
       s.skip(std::string("scan_") + wavog_ros::toString(reason));
@@ -202,6 +239,15 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
                             " scans refused for an absurd pose from tf, the first: " +
                             first_absurd);
   }
+  if (!mounted.empty()) {
+    std::ostringstream mount;
+    mount << o.laser_parent << " <-";
+    for (const auto& f : mounted) mount << " " << f;
+    mount << ":";
+    const std::vector<double> v = o.laser_pose.empty() ? std::vector<double>(6, 0.0) : o.laser_pose;
+    for (double x : v) mount << " " << x;
+    info.laser_mount = mount.str();
+  }
   if (s.integrated() == 0 && !first_tf_error.empty()) {
     std::vector<std::string> frames;
     tf._getFrameStrings(frames);
@@ -212,8 +258,9 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
         << ").\n  Frames in the bag's tf: ";
     if (frames.empty()) msg << "none (the bag has no /tf or /tf_static)";
     for (std::size_t i = 0; i < frames.size(); ++i) msg << (i ? ", " : "") << frames[i];
-    msg << ".\n  Use --fixed-frame <frame> (e.g. the scan frame, to map with the laser held "
-           "fixed).";
+    msg << ".\n  Use --laser-parent <frame> --laser-pose \"x y z yaw pitch roll\" when tf lacks "
+           "only the laser's mount, or --fixed-frame <frame> (e.g. the scan frame, to map with "
+           "the laser held fixed).";
     throw std::runtime_error(msg.str());
   }
   return info;

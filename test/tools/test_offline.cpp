@@ -3,8 +3,9 @@
 // summary.json, snapshots) are written and consistent; with --ndt the NDT pictures have the
 // expected size and summary.json's Gaussian counts equal the core's; the real
 // laser_scan_matcher_demo.bag (no tf, frame "/laser") maps with --fixed-frame laser and its zero
-// readings are rejected (REP 117); clear errors for a missing file, a missing topic and tf that
-// never connects.
+// readings are rejected (REP 117); a laser mount given on the command line (--laser-parent,
+// --laser-pose) maps a bag whose tf lacks it as the mount on /tf_static does; clear errors for a
+// missing file, a missing topic, a bad mount and tf that never connects.
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -412,6 +413,76 @@ TEST(Offline, UpsideDownLaserAndMotionCompensationInABag) {
   EXPECT_LT(mirror, -1.5f);
 }
 
+// The drive of the test above written to a bag, with the laser's static mount or without it.
+std::string writeDrivingBag(const std::string& name, bool with_mount) {
+  namespace dl = driving_laser;
+  const std::string bag_path = (workDir() / name).string();
+  rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
+  if (with_mount) {
+    tf2_msgs::TFMessage statics;
+    statics.transforms.push_back(dl::mount("laser_down"));
+    bag.write("/tf_static", dl::kT0, statics);
+  }
+  for (const auto& t : dl::drive()) {
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(t);
+    bag.write("/tf", t.header.stamp, tf);
+  }
+  for (int i = 0; i < dl::kScans; ++i) {
+    const sensor_msgs::LaserScan s = dl::scanAt(dl::scanTime(i), "laser_down");
+    bag.write("/scan", s.header.stamp, s);
+  }
+  return bag_path;
+}
+
+TEST(Offline, LaserMountFromTheCommandLineWhenTheBagsTfLacksIt) {
+  // A bag whose tf has the robot but not its laser (as the oko bag): the tool says how to give the
+  // mount; given as the launch's laser_parent / laser_pose would give it, the map is the map of
+  // the same bag with the mount on /tf_static.
+  const std::string mounted = writeDrivingBag("mounted.bag", true);
+  const std::string bare = writeDrivingBag("no_mount.bag", false);
+  const std::string out_mounted = (workDir() / "mounted").string();
+  const std::string out_bare = (workDir() / "no_mount").string();
+  RunResult r = run(WAVOG_OFFLINE, "--no-progress -o " + out_bare + " " + bare);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("tf never connects the scan frame 'laser_down'"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("--laser-parent"), std::string::npos) << r.err;
+
+  r = run(WAVOG_OFFLINE, "--no-progress -o " + out_mounted + " " + mounted);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Upside down 0.2 m ahead of base_link: roll pi (x y z yaw pitch roll).
+  const std::string pose =
+      " --laser-pose \"" + std::to_string(driving_laser::kMount) + " 0 0 0 0 3.141592653589793\" ";
+  r = run(WAVOG_OFFLINE,
+          "--no-progress --laser-parent /base_link" + pose + "-o " + out_bare + " " + bare);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json json = readJson(fs::path(out_bare) / "summary.json");
+  EXPECT_EQ(json["scans_integrated"], 20) << json;
+  EXPECT_EQ(
+      json["laser_mount"].get<std::string>().rfind("base_link <- laser_down: 0.2 0 0 0 0 3.14", 0),
+      0u)
+      << json;
+  wavog::WaveletMap a(defaultParams()), b(defaultParams());
+  a.load((fs::path(out_mounted) / "map.wavog").string());
+  b.load((fs::path(out_bare) / "map.wavog").string());
+  const MapDiff d = compare(a, b);
+  EXPECT_GT(d.cells, 1000u);
+  EXPECT_EQ(d.known_mismatch, 0u);
+  EXPECT_EQ(d.value_mismatch, 0u) << "max difference " << d.max_diff;
+
+  // A bag that has the mount: two places for one frame is an error, not a silent choice.
+  r = run(WAVOG_OFFLINE,
+          "--no-progress --laser-parent base_link" + pose + "-o " + out_mounted + " " + mounted);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("the bag's tf already places the scan frame 'laser_down' in 'base_link'"),
+            std::string::npos)
+      << r.err;
+  r = run(WAVOG_OFFLINE, "--no-progress --laser-parent laser_down -o " + out_bare + " " + bare);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("is the scan frame itself"), std::string::npos) << r.err;
+}
+
 TEST(Offline, AbsurdPoseFromTfIsRefusedAsTheNodeRefusesIt) {
   // The drive of the test above, but one odometry sample (at 0.51 s) jumps 2 km ahead and back, as
   // the oko bag's odometry does: scan 5 (0.505-0.523 s) starts between it and a sane sample, so tf
@@ -491,6 +562,17 @@ TEST(Offline, ClearErrors) {
   r = run(WAVOG_OFFLINE, "--no-progress --resolution 0.05x -o " + out + " " + bag);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("--resolution: not a number: '0.05x'"), std::string::npos) << r.err;
+  r = run(WAVOG_OFFLINE,
+          "--no-progress --laser-parent base_link --laser-pose \"0 0 1\" -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--laser-pose: 6 numbers"), std::string::npos) << r.err;
+  r = run(WAVOG_OFFLINE, "--no-progress --laser-parent base_link --laser-pose \"0 0 0 0 0 x\" -o " +
+                             out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--laser-pose: not a number: 'x'"), std::string::npos) << r.err;
+  r = run(WAVOG_OFFLINE, "--no-progress --laser-pose \"0 0 0 0 0 0\" -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--laser-pose needs --laser-parent"), std::string::npos) << r.err;
   r = run(WAVOG_OFFLINE, "--no-progress --scale 0,2.5 -o " + out + " " + bag);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("--scale: not a whole number >= 0: '2.5'"), std::string::npos) << r.err;
