@@ -178,6 +178,8 @@ const std::vector<KeyReader>& readers() {
        [](auto& k, auto& v, Config* c) { c->ros.subscriber_queue_size = asInt(k, v); }},
       {"motion_compensation",
        [](auto& k, auto& v, Config* c) { c->ros.motion_compensation = asBool(k, v); }},
+      {"max_sensor_speed",
+       [](auto& k, auto& v, Config* c) { c->ros.max_sensor_speed = asDouble(k, v); }},
       {"map_file", [](auto& k, auto& v, Config* c) { c->ros.map_file = asString(k, v); }},
       {"map_dir", [](auto& k, auto& v, Config* c) { c->ros.map_dir = asString(k, v); }},
       {"rate_tolerance",
@@ -326,6 +328,9 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
         &e, "map_dir ('" + ros.map_dir + "') must be an absolute path without '..' (empty: the ROS home)");
   check(std::isfinite(ros.rate_tolerance) && ros.rate_tolerance >= 0.0 && ros.rate_tolerance < 1.0,
         &e, "rate_tolerance (" + fmt(ros.rate_tolerance) + ") must be in [0, 1)");
+  check(std::isfinite(ros.max_sensor_speed) && ros.max_sensor_speed > 0.0 &&
+            ros.max_sensor_speed <= 1000.0,
+        &e, "max_sensor_speed (" + fmt(ros.max_sensor_speed) + ") must be in (0, 1000] m/s");
   check(std::isfinite(ros.idle_timeout) && ros.idle_timeout >= 0.0 && ros.idle_timeout <= 3600.0,
         &e, "idle_timeout (" + fmt(ros.idle_timeout) + ") must be in [0, 3600] s (0: never)");
   check(static_cast<int>(ros.fleet_vehicles.size()) <= kMaxFleetVehicles, &e,

@@ -127,6 +127,7 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
   in->topic = nh_.resolveName(ic.topic);
   in->min_freq = ic.expected_rate * (1.0 - rp.rate_tolerance);
   in->max_freq = ic.expected_rate * (1.0 + rp.rate_tolerance);
+  in->poses = PoseCheck(rp.max_sensor_speed);
   Input* raw = in.get();
   // subscriber -> onScan (checks) -> tf filter -> onTransformable (placement, core).
   in->filter = std::make_unique<ScanFilter>(*buffer_, rp.map_frame,

@@ -166,7 +166,7 @@ InputInfo runBag(const Options& o, const wavog_ros::Config& config,
   wavog::MotionCompensator compensator;
   // As the node: a scan whose laser would move faster than a vehicle is refused (a corrupt
   // odometry sample), the first refusal's reason goes to the warnings.
-  wavog_ros::PoseCheck poses;
+  wavog_ros::PoseCheck poses(config.ros.max_sensor_speed);
   std::size_t absurd_poses = 0;
   std::string first_absurd;
   wavog_ros::PlacementOptions placement_options;

@@ -69,6 +69,7 @@ void expectSame(const Config& a, const Config& b) {
   EXPECT_EQ(a.ros.queue_size, b.ros.queue_size);
   EXPECT_EQ(a.ros.subscriber_queue_size, b.ros.subscriber_queue_size);
   EXPECT_EQ(a.ros.motion_compensation, b.ros.motion_compensation);
+  EXPECT_EQ(a.ros.max_sensor_speed, b.ros.max_sensor_speed);
   EXPECT_EQ(a.ros.map_file, b.ros.map_file);
   EXPECT_EQ(a.ros.rate_tolerance, b.ros.rate_tolerance);
 }
@@ -170,15 +171,18 @@ TEST(Config, BadValuesNameTheParameterAndItsRange) {
   EXPECT_NE(errorOf("inputs: [a, a]").find("twice"), std::string::npos);
   EXPECT_NE(errorOf("queue_size: 0").find("queue_size (0) must be in [1, 1000]"),
             std::string::npos);
-  EXPECT_NE(errorOf("subscriber_queue_size: 0")
-                .find("subscriber_queue_size (0) must be in [1, 100000]"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf("subscriber_queue_size: 0").find("subscriber_queue_size (0) must be in [1, 100000]"),
+      std::string::npos);
   EXPECT_NE(errorOf("tf_tolerance: 2").find("tf_tolerance"), std::string::npos);
   EXPECT_NE(errorOf("map_frame: /map").find("map_frame"), std::string::npos);
   EXPECT_NE(errorOf("policy: forgetful").find("policy"), std::string::npos);
   EXPECT_NE(errorOf("scale_aggregation: median").find("mean, max"), std::string::npos);
   EXPECT_NE(errorOf("resolution: abc").find("'resolution'"), std::string::npos);
   EXPECT_NE(errorOf("queue_size: 2.5").find("integer"), std::string::npos);
+  EXPECT_NE(errorOf("max_sensor_speed: 0").find("max_sensor_speed (0) must be in (0, 1000] m/s"),
+            std::string::npos);
+  EXPECT_NE(errorOf("max_sensor_speed: .nan").find("max_sensor_speed"), std::string::npos);
   EXPECT_NE(errorOf("motion_compensation: 1").find("true or false"), std::string::npos);
   EXPECT_NE(errorOf("gamma: 0").find("gamma"), std::string::npos);
   EXPECT_NE(errorOf("num_threads: -1").find("num_threads (-1) must be an integer in [0, 256]"),

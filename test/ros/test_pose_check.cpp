@@ -28,7 +28,8 @@ TEST(PoseCheck, OkoLikeOdometryJumpsRefusedAndMappingGoesOn) {
   // at 5.9e22: each refused, naming the speed.
   for (const double y : {1.9e32, -2.76e7, -2.76e5, 5.9e22}) {
     const std::string why = still(&c, at(0.16, y), 1.6);
-    EXPECT_NE(why.find("faster than 50 m/s"), std::string::npos) << y << ": " << why;
+    EXPECT_NE(why.find("faster than max_sensor_speed 50 m/s"), std::string::npos)
+        << y << ": " << why;
   }
   // The next sane pose (0.8 s later, a few cm on) is taken: the reference is the last accepted.
   EXPECT_EQ(still(&c, at(0.17, -0.13), 2.4), "");
@@ -65,6 +66,18 @@ TEST(PoseCheck, RealJumpConfirmedByTheNextScan) {
   EXPECT_NE(still(&c, at(200.0, 0.0), 0.1), "");
   EXPECT_EQ(still(&c, at(200.1, 0.0), 0.2), "");
   EXPECT_EQ(still(&c, at(200.2, 0.0), 0.3), "");
+}
+
+TEST(PoseCheck, MaxSensorSpeedSetsTheBound) {
+  // A car at 60 m/s (216 km/h) is refused by the default 50 m/s and accepted at 80 m/s; at 1 m/s
+  // (a slow indoor robot) a 3 m jump in 1 s is refused.
+  PoseCheck slow_default, fast(80.0), indoor(1.0);
+  for (PoseCheck* c : {&slow_default, &fast, &indoor}) EXPECT_EQ(still(c, at(0.0, 0.0), 0.0), "");
+  EXPECT_NE(still(&slow_default, at(60.0, 0.0), 1.0), "");
+  EXPECT_EQ(still(&fast, at(60.0, 0.0), 1.0), "");
+  const std::string why = still(&indoor, at(3.0, 0.0), 1.0);
+  EXPECT_NE(why.find("faster than max_sensor_speed 1 m/s"), std::string::npos) << why;
+  EXPECT_EQ(still(&indoor, at(1.5, 0.0), 1.0), "");  // 1 m/s x 1 s + 1 m of slack
 }
 
 TEST(PoseCheck, FramesAndTimeScaleTheBound) {

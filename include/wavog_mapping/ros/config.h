@@ -60,6 +60,9 @@ struct RosParams {
   int subscriber_queue_size = 1000;
   /// Place each beam with the sensor pose interpolated over the sweep (needs time_increment).
   bool motion_compensation = true;
+  /// Fastest plausible laser (m/s), in (0, 1000]: a scan whose pose from tf implies a faster
+  /// move (a corrupt odometry sample) is refused as absurd_pose (pose_check.h).
+  double max_sensor_speed = 50.0;
   /// Native map file loaded at start-up; empty: start with an empty map.
   std::string map_file;
   /// Directory ~save_map writes below (absolute, no '..'); relative paths resolve under it.

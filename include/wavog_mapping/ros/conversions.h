@@ -29,7 +29,7 @@ enum class DropReason {
   kNoValidBeam,    ///< no beam to integrate: each invalid, or a no return (REP 117)
   kBadGeometry,    ///< refused by the core: a limit of limits.h (angles, beams, range limits)
   kOutOfExtent,    ///< refused by the core: pose plus reach outside the representable extent
-  kAbsurdPose,     ///< the laser's pose jumps faster than kMaxSensorSpeed, or is not finite
+  kAbsurdPose,     ///< the laser's pose jumps faster than max_sensor_speed, or is not finite
   kBadTime,        ///< stamp or time_increment outside what ROS time arithmetic can represent
   kException,      ///< an exception was caught while handling the scan (logged)
 };
