@@ -370,28 +370,37 @@ TEST(Offline, RealDataLaserScanMatcherDemoBagWithFixedFrameRejectsZeroReadings) 
   EXPECT_LE(map.value(map.cellAt(0.0, 0.0)), 0.0f);
 }
 
+// The drive of driving_laser.h written to a bag, the laser in `laser_frame`, with its static mount
+// on /tf_static or without it.
+std::string writeDrivingBag(const std::string& name, const std::string& laser_frame,
+                            bool with_mount) {
+  namespace dl = driving_laser;
+  const std::string bag_path = (workDir() / name).string();
+  rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
+  if (with_mount) {
+    tf2_msgs::TFMessage statics;
+    statics.transforms.push_back(dl::mount(laser_frame));
+    bag.write("/tf_static", dl::kT0, statics);
+  }
+  for (const auto& t : dl::drive()) {
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(t);
+    bag.write("/tf", t.header.stamp, tf);
+  }
+  for (int i = 0; i < dl::kScans; ++i) {
+    const sensor_msgs::LaserScan s = dl::scanAt(dl::scanTime(i), laser_frame);
+    bag.write("/scan", s.header.stamp, s);
+  }
+  return bag_path;
+}
+
 TEST(Offline, UpsideDownLaserAndMotionCompensationInABag) {
   // A robot driving along x at 1 m/s with a laser mounted upside down 0.2 m ahead of base_link;
   // beams are timed (time_increment), so each sweep is re-binned. The placement itself (poses,
   // mirroring) is tested in test/ros/test_scan_placement.cpp; here: the bag's tf (with its leading
   // '/' frames) reaches it and the summary counts it.
   namespace dl = driving_laser;
-  const std::string bag_path = (workDir() / "synthetic.bag").string();
-  {
-    rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
-    tf2_msgs::TFMessage statics;
-    statics.transforms.push_back(dl::mount("/laser_down"));
-    bag.write("/tf_static", dl::kT0, statics);
-    for (const auto& t : dl::drive()) {
-      tf2_msgs::TFMessage tf;
-      tf.transforms.push_back(t);
-      bag.write("/tf", t.header.stamp, tf);
-    }
-    for (int i = 0; i < dl::kScans; ++i) {
-      const sensor_msgs::LaserScan s = dl::scanAt(dl::scanTime(i), "/laser_down");
-      bag.write("/scan", s.header.stamp, s);
-    }
-  }
+  const std::string bag_path = writeDrivingBag("synthetic.bag", "/laser_down", true);
   const std::string out = (workDir() / "synthetic").string();
   const RunResult r = run(WAVOG_OFFLINE, "--no-progress -o " + out + " " + bag_path);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -413,34 +422,12 @@ TEST(Offline, UpsideDownLaserAndMotionCompensationInABag) {
   EXPECT_LT(mirror, -1.5f);
 }
 
-// The drive of the test above written to a bag, with the laser's static mount or without it.
-std::string writeDrivingBag(const std::string& name, bool with_mount) {
-  namespace dl = driving_laser;
-  const std::string bag_path = (workDir() / name).string();
-  rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
-  if (with_mount) {
-    tf2_msgs::TFMessage statics;
-    statics.transforms.push_back(dl::mount("laser_down"));
-    bag.write("/tf_static", dl::kT0, statics);
-  }
-  for (const auto& t : dl::drive()) {
-    tf2_msgs::TFMessage tf;
-    tf.transforms.push_back(t);
-    bag.write("/tf", t.header.stamp, tf);
-  }
-  for (int i = 0; i < dl::kScans; ++i) {
-    const sensor_msgs::LaserScan s = dl::scanAt(dl::scanTime(i), "laser_down");
-    bag.write("/scan", s.header.stamp, s);
-  }
-  return bag_path;
-}
-
 TEST(Offline, LaserMountFromTheCommandLineWhenTheBagsTfLacksIt) {
   // A bag whose tf has the robot but not its laser (as the oko bag): the tool says how to give the
   // mount; given as the launch's laser_parent / laser_pose would give it, the map is the map of
   // the same bag with the mount on /tf_static.
-  const std::string mounted = writeDrivingBag("mounted.bag", true);
-  const std::string bare = writeDrivingBag("no_mount.bag", false);
+  const std::string mounted = writeDrivingBag("mounted.bag", "laser_down", true);
+  const std::string bare = writeDrivingBag("no_mount.bag", "laser_down", false);
   const std::string out_mounted = (workDir() / "mounted").string();
   const std::string out_bare = (workDir() / "no_mount").string();
   RunResult r = run(WAVOG_OFFLINE, "--no-progress -o " + out_bare + " " + bare);
