@@ -26,6 +26,7 @@ Config loadReportingUnknown(const ros::NodeHandle& pnh) {
     ROS_WARN("%s: unknown parameter '%s' ignored (config/default.yaml lists every key)",
              pnh.getNamespace().c_str(), key.c_str());
   }
+  for (const auto& w : c.map.warnings()) ROS_WARN("%s: %s", pnh.getNamespace().c_str(), w.c_str());
   return c;
 }
 
@@ -238,6 +239,13 @@ std::vector<std::string> MappingRos::Impl::onReconfigure(const wavog_mapping::Ma
       ROS_INFO("%s: the reflection map restarts from no hits and misses (policy, prior or odd "
                "values changed)",
                pnh_.getNamespace().c_str());
+    }
+    // A policy change can make a silent combination (MapParams::warnings) or end one.
+    const std::vector<std::string> before = config_.map.warnings();
+    for (const auto& w : next.map.warnings()) {
+      if (std::find(before.begin(), before.end(), w) == before.end()) {
+        ROS_WARN("%s: %s", pnh_.getNamespace().c_str(), w.c_str());
+      }
     }
     if (next.ros.publish_rate != config_.ros.publish_rate) new_period = 1.0 / next.ros.publish_rate;
     // Only the run-time fields: the others (frames, ...) are read without the lock.

@@ -332,6 +332,11 @@ wavog_ros::Config prepare(const Options& o) {
     for (const auto& k : unknown) std::cerr << " " << k;
     std::cerr << "\n";
   }
+  if (!o.quiet) {
+    for (const auto& w : config.map.warnings()) {
+      std::cerr << "wavog_offline: warning: " << w << "\n";
+    }
+  }
   for (int s : o.scales) {
     if (s < 0 || s > config.map.grid.block_levels) {
       throw std::invalid_argument(

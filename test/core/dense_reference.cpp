@@ -199,23 +199,26 @@ void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& 
 
 // Normal-distribution cells (MapParams::ndt) of layer 0: every observed cell's moments forget by
 // 1 - gamma ("forget"), then each end-point adds itself with weight gamma (1 for the other
-// policies), the clamp policies cap the weight, and cells under ndt_min_weight are dropped.
+// policies), the clamp policies cap the weight, and the cells the scan changed that weigh less
+// than ndt_min_weight of its end-points (ndt_min_weight times that weight) are dropped.
 void DenseReference::integrateNdt(const ReferenceClassifier& ref, const wavog::Pose2& pose,
                                   const wavog::ScanView& scan) {
   const wavog::MapParams& p = layers_.at(0);
   const bool forget = p.policy.type == PolicyType::kForget;
   const double g = forget ? p.policy.gamma : 1.0;
+  // The cells whose weight the scan changes: the observed ones (forgetting) and the touched ones.
+  std::set<std::pair<std::int64_t, std::int64_t>> changed, touched;
   if (forget) {
     for (auto& kv : ndt_) {
       const wavog::CellClass cls = ref.cellClass(kv.first.second, kv.first.first);
       if (cls == wavog::CellClass::kUnknown) continue;
       Moments& m = kv.second;
       for (double* v : {&m.w, &m.x, &m.y, &m.xx, &m.xy, &m.yy}) *v *= 1.0 - g;
+      changed.insert(kv.first);
     }
   }
   // The end-points, in the core's beam order (ascending bearing).
   std::vector<std::pair<double, double>> points = ref.endpoints(pose, scan);
-  std::set<std::pair<std::int64_t, std::int64_t>> touched;
   const double res = p.grid.resolution;
   for (const auto& e : points) {
     const std::pair<std::int64_t, std::int64_t> key{
@@ -238,12 +241,10 @@ void DenseReference::integrateNdt(const ReferenceClassifier& ref, const wavog::P
       for (double* v : {&m.w, &m.x, &m.y, &m.xx, &m.xy, &m.yy}) *v *= f;
     }
   }
-  for (auto it = ndt_.begin(); it != ndt_.end();) {
-    if (it->second.w >= p.ndt_min_weight && it->second.w > 0.0) {
-      ++it;
-    } else {
-      it = ndt_.erase(it);
-    }
+  changed.insert(touched.begin(), touched.end());
+  for (const auto& key : changed) {
+    const auto it = ndt_.find(key);
+    if (!(it->second.w >= p.ndt_min_weight * g && it->second.w > 0.0)) ndt_.erase(it);
   }
 }
 

@@ -213,6 +213,100 @@ TEST(Ndt, WallGaussiansAndTheirForgetting) {
   EXPECT_GT(map.stats().ndt_cells, 10u) << "the far wall's";
 }
 
+// A straight wall at x m seen from the origin by 31 beams 2 deg apart (over +-30 deg): at most one
+// end-point per 0.1 m cell and scan at 3.03 m.
+OwnedScan straightWall(double x) {
+  OwnedScan s;
+  s.pose = {0.0, 0.0, 0.0};
+  s.angle_min = -M_PI / 6;
+  s.angle_increment = M_PI / 90;
+  s.range_min = 0.1;
+  s.range_max = 10.0;
+  for (int j = 0; j < 31; ++j) {
+    s.ranges.push_back(static_cast<float>(x / std::cos(s.angle_min + j * s.angle_increment)));
+  }
+  return s;
+}
+
+// Issue 38: under forgetting a new end-point weighs the scan's rate g (0.3 by gamma, 6.9e-5 with
+// a half-life of 1000 s at 10 Hz) and ndt_min_weight counts end-points, so a wall seen every
+// scan keeps every Gaussian at every half-life and rate: 300 scans give each wall cell the
+// weight 1 - (1 - g)^300, the same Gaussians as with no floor at all.
+TEST(Ndt, WallSeenEveryScanKeepsItsGaussianAtEveryHalfLifeAndRate) {
+  const OwnedScan wall = straightWall(3.03);
+  for (double rate : {10.0, 40.0}) {
+    for (double half_life : {0.0, 5.0, 7.0, 10.0, 100.0, 1000.0, 1e6}) {
+      const std::string what =
+          "half-life " + std::to_string(half_life) + " s at " + std::to_string(rate) + " Hz";
+      SCOPED_TRACE(what);
+      MapParams p = ndtParams(PolicyType::kForget, 0.1, 6);
+      p.policy.forget_half_life = half_life;
+      ASSERT_EQ(p.ndt_min_weight, 0.01);  // the default
+      MapParams no_floor = p;
+      no_floor.ndt_min_weight = 0.0;
+      WaveletMap map(p), all(no_floor);
+      wavog::ScanView v = wall.view();
+      v.period = 1.0 / rate;
+      for (int i = 0; i < 300; ++i) {
+        map.integrate(wall.pose, v);
+        all.integrate(wall.pose, v);
+      }
+      const double g = map.forgetRate(v.period);
+      EXPECT_EQ(map.stats().ndt_cells, all.stats().ndt_cells);
+      EXPECT_GE(all.stats().ndt_cells, 31u);
+      NdtCell c;  // the cell of the beam at 2 deg
+      if (!map.ndtCell(map.cellAt(3.03, 3.03 * std::tan(M_PI / 90)), &c)) {
+        ADD_FAILURE() << "the wall's Gaussian is gone, g " << g;
+        continue;
+      }
+      EXPECT_NEAR(c.weight, 1.0 - std::pow(1.0 - g, 300), 1e-9 * c.weight + 1e-15);
+      EXPECT_NEAR(c.mean_x, 3.03, 1e-6);
+    }
+  }
+}
+
+// ndt_min_weight in end-points under forgetting: a Gaussian of one end-point, observed from then
+// on without another, lasts as long as (1 - g)^k >= ndt_min_weight, log2(1 / 0.01) = 6.6
+// half-lives of observation by default, whatever the half-life and the rate (13 scans by gamma
+// 0.3). A wall seen every scan holds 1 / g end-points' worth and lasts log2(1 / (0.01 g)).
+TEST(Ndt, OneEndPointLastsMinWeightOfItsWorthAtEveryRate) {
+  const OwnedScan wall = straightWall(3.03), gone = straightWall(8.0);
+  for (double rate : {10.0, 40.0}) {
+    for (double half_life : {0.0, 5.0}) {
+      SCOPED_TRACE("half-life " + std::to_string(half_life) + " s at " + std::to_string(rate));
+      MapParams p = ndtParams(PolicyType::kForget, 0.1, 6);
+      p.policy.forget_half_life = half_life;
+      WaveletMap map(p);
+      wavog::ScanView v = wall.view();
+      v.period = 1.0 / rate;
+      map.integrate(wall.pose, v);
+      const double g = map.forgetRate(v.period);
+      const wavog::CellIndex cell = map.cellAt(3.03, 3.03 * std::tan(M_PI / 90));  // 2 deg
+      // The first k with (1 - g)^k < 0.01: the Gaussian is there after k - 1 observations of
+      // free space, gone after k + 1.
+      const int k = static_cast<int>(std::floor(std::log(0.01) / std::log1p(-g))) + 1;
+      if (half_life == 0.0) {
+        EXPECT_EQ(k, 13);
+      } else {
+        EXPECT_NEAR(k * v.period, half_life * std::log2(100.0), 2.0 * v.period);
+      }
+      v = gone.view();
+      v.period = 1.0 / rate;
+      NdtCell c;
+      for (int i = 1; i <= k + 1; ++i) {
+        map.integrate(gone.pose, v);
+        if (i != k - 1) continue;
+        if (map.ndtCell(cell, &c)) {
+          EXPECT_NEAR(c.weight, g * std::pow(1.0 - g, i), 1e-9 * c.weight);
+        } else {
+          ADD_FAILURE() << "gone after " << i << " observations, g " << g;
+        }
+      }
+      EXPECT_FALSE(map.ndtCell(cell, &c)) << "after " << k + 1 << " observations";
+    }
+  }
+}
+
 TEST(Ndt, OffByDefaultAndOccupancyUnchangedWhenOn) {
   MapParams plain = MapParams::defaultsFor(PolicyType::kForget);
   plain.grid.resolution = 0.1;
@@ -240,6 +334,49 @@ TEST(Ndt, InvalidParametersNamed) {
   EXPECT_NE(errors[0].find("ndt_min_weight"), std::string::npos);
   EXPECT_NE(errors[1].find("ndt_max_weight"), std::string::npos);
   EXPECT_THROW(WaveletMap{p}, std::invalid_argument);
+}
+
+// Issue 38: the valid combinations that keep no Gaussian of a wall seen every scan are named with
+// their values; every policy, half-life and floor up to 1 end-point keeps them and is not named.
+TEST(Ndt, CombinationsThatKeepNoGaussianAreNamed) {
+  for (PolicyType type : everyPolicyType()) {
+    for (double half_life : {0.0, 60.0, 1e6}) {
+      for (double min_weight : {0.0, 0.01, 1.0}) {
+        MapParams p = ndtParams(type, 0.1, 5);
+        p.policy.forget_half_life = half_life;
+        p.ndt_min_weight = min_weight;
+        p.ndt_max_weight = 1.0;
+        EXPECT_TRUE(p.warnings().empty()) << wavog::toString(type) << " " << half_life;
+      }
+    }
+    MapParams over = ndtParams(type, 0.1, 5);
+    over.ndt_min_weight = 2.5;
+    over.ndt_max_weight = 3.0;
+    ASSERT_EQ(over.warnings().size(), 1u) << wavog::toString(type);
+    EXPECT_NE(over.warnings()[0].find("ndt_min_weight (2.5) is over 1 end-point"),
+              std::string::npos)
+        << over.warnings()[0];
+    over.ndt = false;
+    EXPECT_TRUE(over.warnings().empty());
+  }
+  MapParams capped = ndtParams(PolicyType::kClampUpper, 0.1, 5);
+  capped.ndt_min_weight = 5.0;
+  capped.ndt_max_weight = 4.0;
+  ASSERT_EQ(capped.warnings().size(), 1u);
+  EXPECT_NE(capped.warnings()[0].find("ndt_max_weight (4) is under ndt_min_weight (5) with policy "
+                                      "clamp_upper"),
+            std::string::npos)
+      << capped.warnings()[0];
+  // What the warnings say: a floor over 1 keeps no Gaussian of one end-point per cell and scan,
+  // a cap under the floor none at all.
+  const OwnedScan wall = straightWall(3.03);
+  MapParams over_one = ndtParams(PolicyType::kForget, 0.1, 6);
+  over_one.ndt_min_weight = 1.5;
+  for (const MapParams& p : {capped, over_one}) {
+    WaveletMap map(p);
+    for (int i = 0; i < 20; ++i) map.integrate(wall.pose, wall.view());
+    EXPECT_EQ(map.stats().ndt_cells, 0u) << wavog::toString(p.policy.type);
+  }
 }
 
 // Save and load: the Gaussians come back bit for bit, and the loaded map goes on as the original;

@@ -2,8 +2,10 @@
 // (PointCloud2, latched) for the finest scale, ndt_markers_scale_<s> / ndt_cells_scale_<s> while
 // subscribed. The four lasers see the room for 1 s: every Gaussian holds beam end-points, so its
 // mean lies on a wall (within a cell at the corners), its ellipse runs along the wall, and it is
-// drawn red (occupied). A node with ndt: false advertises none of these topics, and a bad
-// ndt_min_weight stops the node at start-up naming the parameter.
+// drawn red (occupied). A node with forget_half_life: 60 keeps at least the same Gaussians from
+// the same scans (issue 38: before, its end-points weighed 0.001 and fell under ndt_min_weight).
+// A node with ndt: false advertises none of these topics, a bad ndt_min_weight stops the node at
+// start-up naming the parameter, and a floor that keeps no Gaussian is warned about.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -32,6 +34,8 @@ std::mutex g_mutex;
 wavog_mapping::MapperStatus::ConstPtr g_status;
 visualization_msgs::MarkerArray::ConstPtr g_markers, g_markers_2;
 sensor_msgs::PointCloud2::ConstPtr g_cells, g_cells_2;
+wavog_mapping::MapperStatus::ConstPtr g_half_life_status;  // the forget_half_life: 60 node's
+sensor_msgs::PointCloud2::ConstPtr g_half_life_cells;
 
 /// Distance from (x, y) inside the room to its nearest wall.
 double wallDistance(double x, double y) {
@@ -121,7 +125,7 @@ TEST(NdtTopics, EllipsesOnTheWallsCloudAgreesScaleMergesExactly) {
   for (int i = 1; i <= 4; ++i) {
     pubs.push_back(nh.advertise<sensor_msgs::LaserScan>("scan_" + std::to_string(i), 100));
   }
-  for (const auto& p : pubs) room::waitForSubscribers(p, 1, 20.0);
+  for (const auto& p : pubs) room::waitForSubscribers(p, 2, 20.0);  // the two ndt: true nodes
   const ros::Time t0 = ros::Time::now();
   for (int k = 0; k < kScansPerLaser; ++k) {
     for (std::size_t i = 0; i < pubs.size(); ++i) {
@@ -129,20 +133,22 @@ TEST(NdtTopics, EllipsesOnTheWallsCloudAgreesScaleMergesExactly) {
     }
     ros::WallDuration(0.005).sleep();
   }
-  const auto status = room::waitLatest(
-      &g_mutex, &g_status,
-      [](const wavog_mapping::MapperStatus& s) {
-        if (s.inputs.size() != 4) return false;
-        for (const auto& in : s.inputs) {
-          if (in.integrated < static_cast<unsigned>(kScansPerLaser)) return false;
-        }
-        return true;
-      },
-      30.0);
-  ASSERT_TRUE(status);
-  ASSERT_EQ(status->inputs.size(), 4u);
-  for (const auto& in : status->inputs) {
-    ASSERT_EQ(in.integrated, static_cast<decltype(in.integrated)>(kScansPerLaser));
+  const auto all_integrated = [](const wavog_mapping::MapperStatus& s) {
+    if (s.inputs.size() != 4) return false;
+    for (const auto& in : s.inputs) {
+      if (in.integrated < static_cast<unsigned>(kScansPerLaser)) return false;
+    }
+    return true;
+  };
+  const auto status = room::waitLatest(&g_mutex, &g_status, all_integrated, 30.0);
+  const auto half_life_status =
+      room::waitLatest(&g_mutex, &g_half_life_status, all_integrated, 30.0);
+  ASSERT_TRUE(status && half_life_status);
+  for (const auto* st : {&status, &half_life_status}) {
+    ASSERT_EQ((*st)->inputs.size(), 4u);
+    for (const auto& in : (*st)->inputs) {
+      ASSERT_EQ(in.integrated, static_cast<decltype(in.integrated)>(kScansPerLaser));
+    }
   }
   {
     std::lock_guard<std::mutex> lock(g_mutex);
@@ -150,10 +156,12 @@ TEST(NdtTopics, EllipsesOnTheWallsCloudAgreesScaleMergesExactly) {
     g_markers_2.reset();
     g_cells.reset();
     g_cells_2.reset();
+    g_half_life_cells.reset();
   }
   const auto markers = fresh(&g_markers), markers_2 = fresh(&g_markers_2);
   const auto cells = fresh(&g_cells), cells_2 = fresh(&g_cells_2);
-  ASSERT_TRUE(markers && markers_2 && cells && cells_2);
+  const auto half_life_cells = fresh(&g_half_life_cells);
+  ASSERT_TRUE(markers && markers_2 && cells && cells_2 && half_life_cells);
 
   {
     SCOPED_TRACE("ndt_markers");
@@ -189,6 +197,15 @@ TEST(NdtTopics, EllipsesOnTheWallsCloudAgreesScaleMergesExactly) {
   EXPECT_NEAR(wc, wf, 1e-4 * wf);
   EXPECT_NEAR(xc / wc, xf / wf, 1e-3);
   EXPECT_NEAR(yc / wc, yf / wf, 1e-3);
+  // forget_half_life 60 s: each end-point weighs about 0.001 (its scan's rate), yet every cell
+  // the gamma node holds a Gaussian in holds one too (it forgets less), all on the walls.
+  const std::vector<CloudPoint> slow = pointsOf(*half_life_cells);
+  EXPECT_GT(slow.size(), 0u) << "forget_half_life 60 s kept no Gaussian";
+  EXPECT_GE(slow.size(), fine.size());
+  for (const CloudPoint& p : slow) {
+    EXPECT_LT(wallDistance(p.x, p.y), kResolution) << p.x << ", " << p.y;
+    EXPECT_GT(p.w, 0.0f);
+  }
 }
 
 TEST(NdtTopics, AdvertisedOnlyWithNdt) {
@@ -229,6 +246,18 @@ TEST(NdtTopics, BadMinWeightFailsAtStartUpNamingIt) {
   EXPECT_NE(output.find("ndt_min_weight (-1) must be in [0, 1e6]"), std::string::npos) << output;
 }
 
+// Issue 38: a valid floor that keeps no Gaussian of a wall is named with its value at start-up
+// (the missing map_file then stops the node at once).
+TEST(NdtTopics, FloorOverOneEndPointIsWarnedAtStartUp) {
+  std::string output;
+  const int code = room::run(std::string("timeout 8 ") + WAVOG_NODE_BIN +
+                                 " __name:=floorndt map:=/floorndt/map _ndt:=true"
+                                 " _ndt_min_weight:=2.0 _map_file:=/nonexistent/none.wavog",
+                             &output);
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find("ndt_min_weight (2) is over 1 end-point"), std::string::npos) << output;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -247,6 +276,10 @@ int main(int argc, char** argv) {
       room::keepLatest<sensor_msgs::PointCloud2>(nh, "ndt_cells", 2, &g_mutex, &g_cells);
   auto cells2_sub =
       room::keepLatest<sensor_msgs::PointCloud2>(nh, "ndt_cells_scale_2", 2, &g_mutex, &g_cells_2);
+  auto half_life_status_sub = room::keepLatest<wavog_mapping::MapperStatus>(
+      nh, "half_life/wavog_mapping/status", 10, &g_mutex, &g_half_life_status);
+  auto half_life_cells_sub = room::keepLatest<sensor_msgs::PointCloud2>(
+      nh, "half_life/ndt_cells", 2, &g_mutex, &g_half_life_cells);
   ros::AsyncSpinner spinner(2);
   spinner.start();
   const int result = RUN_ALL_TESTS();

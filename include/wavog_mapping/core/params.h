@@ -129,13 +129,26 @@ struct MapParams {
   /// (a window of the latest end-points), "clamp_lower" sums. Coarse scales merge their cells'
   /// moments exactly. Off by default: maps, speed and files are then those without it.
   bool ndt = false;
-  /// ndt: a cell whose weight falls under this drops its Gaussian, in [0, 1e6].
+  /// ndt: a Gaussian worth fewer end-points than this is dropped, in [0, 1e6]. The floor is in
+  /// the end-points of the scan that changes the cell: ndt_min_weight times the weight it gives
+  /// an end-point (1, or g under "forget", whose weights are normalised like its occupancy).
+  /// So with ndt_min_weight <= 1 every end-point makes a Gaussian under every policy, half-life
+  /// and scan rate; under "forget" a Gaussian of one end-point then lasts
+  /// log2(1 / ndt_min_weight) half-lives of observation (6.6 by default; by gamma 0.3 it is
+  /// dropped at the 13th scan),
+  /// one of a cell hit every scan (1 / g end-points' worth) log2(1 / (g ndt_min_weight)). Over 1,
+  /// a cell keeps a Gaussian only when one scan puts at least that many end-points in it.
   double ndt_min_weight = 0.01;
   /// ndt with "clamp" / "clamp_upper": the largest weight of a cell, in [1, 1e9].
   double ndt_max_weight = 100.0;
 
   /// Every violated rule, one line each, naming the parameter and its valid range. Empty: valid.
   std::vector<std::string> validate() const;
+
+  /// Valid combinations under which an option silently does (almost) nothing, one line each
+  /// naming the parameters and their values (the node and wavog_offline warn with them at
+  /// start-up). Empty: none.
+  std::vector<std::string> warnings() const;
 
   /// The defaults for a policy: the field initialisers above (the "forget" policy's), with
   /// type = `type` and, for every other policy, odd_occ / odd_emp = kAdditiveOddOcc /

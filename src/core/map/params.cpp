@@ -112,6 +112,27 @@ std::vector<std::string> MapParams::validate() const {
   return v;
 }
 
+std::vector<std::string> MapParams::warnings() const {
+  std::vector<std::string> w;
+  if (!ndt) return w;
+  // A cell that takes one end-point per scan holds 1 end-point's worth of them at least (the
+  // floor is in end-points of the scan, integrate.cpp): only a floor over 1 can defeat it, or a
+  // cap under the floor.
+  const bool capped = policy.type == PolicyType::kClamp || policy.type == PolicyType::kClampUpper;
+  std::ostringstream s;
+  if (capped && ndt_max_weight < ndt_min_weight) {
+    s << "ndt_max_weight (" << ndt_max_weight << ") is under ndt_min_weight (" << ndt_min_weight
+      << ") with policy " << toString(policy.type)
+      << ": every Gaussian is capped under the floor and dropped, none is kept";
+  } else if (ndt_min_weight > 1.0) {
+    s << "ndt_min_weight (" << ndt_min_weight << ") is over 1 end-point: a cell keeps a Gaussian "
+      << "only when one scan puts at least " << ndt_min_weight << " end-points in it, so a "
+      << "wall seen with one end-point per cell and scan keeps none (<= 1 keeps every one)";
+  }
+  if (!s.str().empty()) w.push_back(s.str());
+  return w;
+}
+
 MapParams MapParams::defaultsFor(PolicyType type) {
   MapParams p;  // the field initialisers: the "forget" policy's defaults
   p.policy.type = type;

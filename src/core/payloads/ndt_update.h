@@ -73,7 +73,8 @@ class NdtScanPoints {
 using NdtSpan = CellSpan<NdtEntry>;
 
 /// The policy on the Gaussians for one scan: an observed cell's moments times `a`, each new
-/// end-point weighing `g`, weights capped at `cap`, cells under `min_weight` dropped.
+/// end-point weighing `g`, weights capped at `cap`, cells under `min_weight` dropped (the map's
+/// ndt_min_weight times g: a floor in this scan's end-points).
 struct NdtConsts {
   double a = 1.0;
   double g = 1.0;

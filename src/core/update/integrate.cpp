@@ -50,16 +50,18 @@ CellBox reachBox(double px, double py, double reach, double res) {
 }
 
 // The NDT policy of one scan (params.h, MapParams::ndt): forgetting by the scan's rate, the
-// clamp policies' weight cap, sums otherwise.
+// clamp policies' weight cap, sums otherwise. ndt_min_weight counts end-points: the floor is
+// that many of this scan's end-points (each weighing g under "forget", 1 otherwise), so that an
+// end-point always makes a Gaussian when ndt_min_weight <= 1 (issue 38).
 detail::NdtConsts ndtConsts(const MapParams& p, double a, double g) {
   detail::NdtConsts c;
-  c.min_weight = p.ndt_min_weight;
   if (p.policy.type == PolicyType::kForget) {
     c.a = a;
     c.g = g;
   } else if (p.policy.type == PolicyType::kClamp || p.policy.type == PolicyType::kClampUpper) {
     c.cap = p.ndt_max_weight;
   }
+  c.min_weight = p.ndt_min_weight * c.g;
   return c;
 }
 
