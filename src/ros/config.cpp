@@ -198,6 +198,8 @@ const std::vector<KeyReader>& readers() {
        [](auto& k, auto& v, Config* c) { c->ros.fleet_integrate_late = asBool(k, v); }},
       {"fleet_max_buffered",
        [](auto& k, auto& v, Config* c) { c->ros.fleet_max_buffered = asInt(k, v); }},
+      {"fleet_max_stamp_offset",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_max_stamp_offset = asDouble(k, v); }},
   };
   return kReaders;
 }
@@ -350,6 +352,10 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
   check(ros.fleet_max_buffered >= 1 && ros.fleet_max_buffered <= 1000000, &e,
         "fleet_max_buffered (" + std::to_string(ros.fleet_max_buffered) +
             ") must be in [1, 1000000]");
+  check(std::isfinite(ros.fleet_max_stamp_offset) && ros.fleet_max_stamp_offset > 0.0 &&
+            ros.fleet_max_stamp_offset <= 86400.0,
+        &e, "fleet_max_stamp_offset (" + fmt(ros.fleet_max_stamp_offset) +
+                ") must be in (0, 86400] s");
   return e;
 }
 

@@ -40,7 +40,7 @@ void MappingRos::Impl::startFleet(MapperRole role) {
   // No tf input: an empty buffer keeps the shared paths (publication, flush) valid.
   buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(rp.tf_cache_time));
   fleet_ = std::make_unique<wavog_fleet::FleetReceiver>(
-      nh_, pnh_, rp, &mutex_,
+      nh_, pnh_, rp, config_.map.grid.resolution, &mutex_,
       [this](const wavog::Pose2& pose, const wavog::ScanView& view) {
         return integratePlacedLocked(pose, view);
       },

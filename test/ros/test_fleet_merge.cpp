@@ -129,7 +129,8 @@ wavog_mapping::PlacedScan goodScan() {
 
 Refusal check(const wavog_mapping::PlacedScan& m) {
   std::string detail;
-  const Refusal r = wavog_fleet::checkPlacedScan(m, "map", &detail);
+  const Refusal r =
+      wavog_fleet::checkPlacedScan(m, wavog_fleet::PlacedScanLimits{}, ros::Time(100.0), &detail);
   EXPECT_EQ(r == Refusal::kNone, detail.empty()) << detail;
   return r;
 }
@@ -150,10 +151,30 @@ TEST(PlacedScanCheck, RefusesForeignInputByName) {
   m.theta = std::numeric_limits<double>::infinity();
   EXPECT_EQ(check(m), Refusal::kBadPose);
   m = goodScan();
-  m.angle_increment = 0.0;
-  EXPECT_EQ(check(m), Refusal::kBadPose);
+  m.angle_increment = 0.0;  // scan geometry, as the core's bad_geometry
+  EXPECT_EQ(check(m), Refusal::kBadSize);
+  m = goodScan();
+  m.angle_increment = 1e-310;  // denormal
+  EXPECT_EQ(check(m), Refusal::kBadSize);
   m = goodScan();
   m.header.stamp = ros::Time();
+  EXPECT_EQ(check(m), Refusal::kBadStamp);
+  for (const double bad : {nan, std::numeric_limits<double>::infinity(), 1e30}) {
+    for (int field = 0; field < 6; ++field) {
+      for (const bool compensated : {false, true}) {
+        m = goodScan();
+        m.compensated = compensated;
+        double* f[] = {&m.start_x, &m.start_y, &m.start_theta, &m.end_x, &m.end_y, &m.end_theta};
+        *f[field] = bad;
+        EXPECT_EQ(check(m), Refusal::kBadPose) << "field " << field << " = " << bad;
+      }
+    }
+  }
+  m = goodScan();
+  m.theta = 1e30;
+  EXPECT_EQ(check(m), Refusal::kBadPose);
+  m = goodScan();
+  m.x = 1e8;  // beyond 2^30 cells of 5 cm
   EXPECT_EQ(check(m), Refusal::kBadPose);
   m = goodScan();
   m.ranges.clear();
@@ -265,7 +286,9 @@ TEST(FleetMerge, FleetMapEqualsOneMapOfAllScansInStampOrderForEveryPolicy) {
     std::size_t integrated = 0;
     auto integrate = [&](const OrderKey&, std::size_t i) {
       const auto& m = scans[i].msg;
-      ASSERT_EQ(wavog_fleet::checkPlacedScan(m, "map", nullptr), Refusal::kNone);
+      ASSERT_EQ(wavog_fleet::checkPlacedScan(m, wavog_fleet::PlacedScanLimits{},
+                                             m.header.stamp, nullptr),
+                Refusal::kNone);
       const wavog::IntegrateStats st =
           fleet.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m));
       integrated += st.status == wavog::ScanStatus::kOk;

@@ -1,11 +1,14 @@
 // The fleet map run as a nodelet (test/fleet_nodelet.test): the test streams placed scans as a
 // vehicle's mapper would (PlacedScan on /v1/fleet_scans); the nodelet integrates every one,
 // ~fleet_status counts them, and the map it saves equals, cell for cell, the map the core makes
-// of the same scans under the same parameters.
+// of the same scans under the same parameters. Then hostile messages on /v2/fleet_scans (stamps
+// at and beyond 2^31 s from now, nsec overflow, a far-future stamp, a NaN pose part): the nodelet
+// keeps running, refuses each under its reason, and counts none of them as lost.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -83,7 +86,7 @@ TEST(FleetNodelet, IntegratesPlacedScansAsTheCoreDoes) {
   while (ros::WallTime::now() < deadline) {
     {
       std::lock_guard<std::mutex> lock(mutex);
-      if (status && status->vehicles.size() == 1) integrated = status->vehicles[0].integrated;
+      if (status && !status->vehicles.empty()) integrated = status->vehicles[0].integrated;
     }
     if (integrated == kScans) break;
     ros::WallDuration(0.1).sleep();
@@ -114,6 +117,82 @@ TEST(FleetNodelet, IntegratesPlacedScansAsTheCoreDoes) {
     }
   }
   EXPECT_GT(occupied, 20u) << "the wall is in the map";
+}
+
+/// The latest ~fleet_status, kept by a subscription.
+struct StatusListener {
+  std::mutex mutex;
+  wavog_mapping::FleetStatus::ConstPtr status;
+  ros::Subscriber sub;
+  explicit StatusListener(ros::NodeHandle& nh) {
+    sub = nh.subscribe<wavog_mapping::FleetStatus>(
+        "/wavog_fleet/fleet_status", 10, [this](const wavog_mapping::FleetStatus::ConstPtr& s) {
+          std::lock_guard<std::mutex> lock(mutex);
+          status = s;
+        });
+  }
+  wavog_mapping::FleetStatus::ConstPtr latest() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return status;
+  }
+};
+
+TEST(FleetNodelet, HostileStampsAndPosesAreRefusedAndTheNodeletLives) {
+  ros::NodeHandle nh;
+  StatusListener listener(nh);
+  ros::Publisher pub = nh.advertise<wavog_mapping::PlacedScan>("/v2/fleet_scans", 100);
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(20.0);
+  while (pub.getNumSubscribers() == 0 && ros::WallTime::now() < give_up) {
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_GT(pub.getNumSubscribers(), 0u) << "the fleet nodelet never subscribed to /v2/fleet_scans";
+  ros::WallDuration(0.5).sleep();  // the connection's other side
+
+  const ros::Time t0 = ros::Time::now();
+  std::vector<wavog_mapping::PlacedScan> msgs;
+  for (int i = 0; i < 8; ++i) {
+    msgs.push_back(placedScan(i, t0));
+    msgs.back().vehicle = "v2";
+  }
+  msgs[1].header.stamp.sec = 4294967295u;  // 2^32 - 1 s: more than 2^31 s from now
+  msgs[2].header.stamp.nsec = 0xFFFFFFFFu;  // not normalised
+  msgs[3].header.stamp.sec = 4294967295u;
+  msgs[3].header.stamp.nsec = 0xFFFFFFFFu;
+  msgs[4].header.stamp = t0 + ros::Duration(1e6);  // within ROS time, 11 days ahead
+  msgs[5].start_theta = std::numeric_limits<double>::quiet_NaN();
+  msgs[6].theta = msgs[6].end_theta = 1e30;
+  for (const auto& m : msgs) {
+    pub.publish(m);
+    ros::WallDuration(0.02).sleep();
+  }
+  const std::uint64_t sent = msgs.size();
+  wavog_mapping::FleetStatus::ConstPtr s;
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (ros::WallTime::now() < deadline) {
+    s = listener.latest();
+    if (s && s->vehicles.size() == 2 && s->vehicles[1].received == sent &&
+        s->vehicles[1].integrated == 2 && s->buffered == 0) {
+      break;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  ASSERT_TRUE(s && s->vehicles.size() == 2) << "no ~fleet_status from the nodelet";
+  const wavog_mapping::VehicleStatus& v = s->vehicles[1];
+  EXPECT_EQ(v.vehicle, "v2");
+  EXPECT_EQ(v.received, sent);
+  EXPECT_EQ(v.integrated, 2u);  // scans 0 and 7
+  EXPECT_EQ(v.dropped_bad_stamp, 4u);
+  EXPECT_EQ(v.dropped_bad_pose, 2u);
+  EXPECT_EQ(v.lost, 0u) << "refused messages were delivered";
+  EXPECT_EQ(v.index_regressions + v.index_jumps, 0u);
+  // Alive: it still answers and publishes its status after the hostile messages.
+  const ros::Time stamp = s->header.stamp;
+  const ros::WallTime later = ros::WallTime::now() + ros::WallDuration(10.0);
+  while (ros::WallTime::now() < later && listener.latest()->header.stamp == stamp) {
+    ros::WallDuration(0.1).sleep();
+  }
+  EXPECT_GT(listener.latest()->header.stamp, stamp) << "the nodelet stopped publishing";
+  EXPECT_TRUE(ros::service::exists("/wavog_fleet/save_map", false));
 }
 
 }  // namespace

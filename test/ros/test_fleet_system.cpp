@@ -269,8 +269,9 @@ TEST(Fleet, ThreeVehiclesOneMap) {
     EXPECT_GT(scans[k].size(), 400u);
     EXPECT_EQ(v.received, scans[k].size());
     EXPECT_EQ(v.integrated, scans[k].size());
-    EXPECT_EQ(v.integrated_late + v.dropped_late + v.lost + v.dropped_version + v.dropped_frame +
-                  v.dropped_bad_pose + v.dropped_bad_size + v.dropped_refused + v.dropped_overflow,
+    EXPECT_EQ(v.integrated_late + v.dropped_late + v.lost + v.index_regressions + v.index_jumps +
+                  v.dropped_version + v.dropped_frame + v.dropped_bad_stamp + v.dropped_bad_pose +
+                  v.dropped_bad_size + v.dropped_refused + v.dropped_overflow,
               0u);
     EXPECT_GT(v.bytes, scans[k].size() * 1444u);  // 361 ranges of 4 bytes each, and more
     for (std::size_t i = 0; i < scans[k].size(); ++i) ASSERT_EQ(scans[k][i]->index, i);

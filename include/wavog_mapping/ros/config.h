@@ -94,6 +94,10 @@ struct RosParams {
   bool fleet_integrate_late = true;
   /// Fleet node: most scans in the reorder buffer, in [1, 1000000]; beyond, refused (counted).
   int fleet_max_buffered = 20000;
+  /// Fleet node: a scan stamped farther than this (s) from the fleet node's clock (sim time
+  /// aware) is refused (dropped_bad_stamp), in (0, 86400]: one far-future stamp would otherwise
+  /// make every later scan late. Covers clock skew, the mappers' tf wait and the stream's delay.
+  double fleet_max_stamp_offset = 60.0;
 };
 
 /// Most vehicles one fleet node follows.

@@ -8,6 +8,8 @@
 #include <boost/make_shared.hpp>
 #include <stdexcept>
 
+#include "wavog_mapping/ros/conversions.h"
+
 namespace wavog_fleet {
 namespace {
 
@@ -30,8 +32,7 @@ struct FleetReceiver::Vehicle {
   wavog_mapping::VehicleStatus c;  ///< counters (topic, vehicle filled at start)
   ros::WallTime last_receipt;      ///< zero: nothing yet
   ros::WallTime last_warn;
-  bool has_index = false;
-  std::uint64_t next_index = 0;
+  StreamIndex stream_index;  ///< PlacedScan.index sequence (lost, regressions, jumps)
   bool stale_reported = false;
   double lag_max_period = 0.0;
   ros::Time oldest_unpublished;  ///< stamp of the oldest scan integrated since the last layers
@@ -39,11 +40,12 @@ struct FleetReceiver::Vehicle {
 };
 
 FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
-                             const wavog_ros::RosParams& ros, std::mutex* mutex,
+                             const wavog_ros::RosParams& ros, double resolution,
+                             std::mutex* mutex,
                              IntegrateFn integrate, diagnostic_updater::Updater* updater)
     : nh_(nh),
       pnh_(pnh),
-      map_frame_(ros.map_frame),
+      limits_{ros.map_frame, resolution, ros.fleet_max_stamp_offset},
       stale_timeout_(ros.fleet_stale_timeout),
       integrate_late_(ros.fleet_integrate_late),
       reorder_wait_(ros.fleet_reorder_wait),
@@ -103,22 +105,41 @@ void FleetReceiver::onMessage(Vehicle* v,
     v->stale_reported = false;
     ROS_INFO("%s: vehicle '%s' streams again", pnh_.getNamespace().c_str(), v->name.c_str());
   }
+  // The index first: a message refused below was delivered, so it is not lost.
+  std::uint64_t skipped = 0;
+  switch (v->stream_index.step(m->index, &skipped)) {
+    case IndexStep::kGap:
+      c.lost = saturatingAdd(c.lost, skipped);
+      break;
+    case IndexStep::kRegress:
+      ++c.index_regressions;
+      warnLocked(v, "index " + std::to_string(m->index) + " at or below the previous one (" +
+                        std::to_string(c.index_regressions) +
+                        " so far: a duplicate or a restarted mapper; not counted as lost)");
+      break;
+    case IndexStep::kJump:
+      ++c.index_jumps;
+      warnLocked(v, "index " + std::to_string(m->index) + " more than 2^32 past the previous "
+                        "one (" + std::to_string(c.index_jumps) +
+                        " so far: a corrupt index; not counted as lost)");
+      break;
+    case IndexStep::kFirst:
+    case IndexStep::kNext:
+      break;
+  }
   std::string detail;
-  const Refusal r = checkPlacedScan(*m, map_frame_, &detail);
+  const Refusal r = checkPlacedScan(*m, limits_, ros::Time::now(), &detail);
   if (r != Refusal::kNone) {
-    std::uint64_t* counter = r == Refusal::kVersion  ? &c.dropped_version
-                             : r == Refusal::kFrame  ? &c.dropped_frame
-                             : r == Refusal::kBadPose ? &c.dropped_bad_pose
-                                                      : &c.dropped_bad_size;
+    std::uint64_t* counter = r == Refusal::kVersion    ? &c.dropped_version
+                             : r == Refusal::kFrame    ? &c.dropped_frame
+                             : r == Refusal::kBadStamp ? &c.dropped_bad_stamp
+                             : r == Refusal::kBadPose  ? &c.dropped_bad_pose
+                                                       : &c.dropped_bad_size;
     ++*counter;
     warnLocked(v, std::string("message refused (") + toString(r) + ", " +
                       std::to_string(*counter) + " so far): " + detail);
     return;
   }
-  // Gaps in the stream's index: messages lost on the way (a smaller index: the mapper restarted).
-  if (v->has_index && m->index > v->next_index) c.lost += m->index - v->next_index;
-  v->has_index = true;
-  v->next_index = m->index + 1;
   c.last_stamp = m->header.stamp;
   const OrderKey key{toNs(m->header.stamp), v->index, m->index};
   switch (buffer_.push(key, now.toSec(), m)) {
@@ -170,7 +191,9 @@ void FleetReceiver::integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan&
   }
   ++c.integrated;
   if (integrated_stamp_ < m.header.stamp) integrated_stamp_ = m.header.stamp;
-  const double lag = (ros::Time::now() - m.header.stamp).toSec();
+  // In double seconds: ros::Time's operator- throws beyond 2^31 s (the stamp passed
+  // fleet_max_stamp_offset, but the clock may have jumped since).
+  const double lag = wavog_ros::secondsBetween(ros::Time::now(), m.header.stamp);
   c.lag = lag;
   v->lag_max_period = std::max(v->lag_max_period, lag);
   if (v->oldest_unpublished.isZero() || m.header.stamp < v->oldest_unpublished) {
@@ -182,7 +205,7 @@ void FleetReceiver::layersPublishedLocked(const ros::Time& now) {
   for (auto& v : vehicles_) {
     if (v->oldest_unpublished.isZero()) continue;
     v->publish_lag_max_period =
-        std::max(v->publish_lag_max_period, (now - v->oldest_unpublished).toSec());
+        std::max(v->publish_lag_max_period, wavog_ros::secondsBetween(now, v->oldest_unpublished));
     v->oldest_unpublished = ros::Time();
   }
 }
@@ -203,7 +226,7 @@ void FleetReceiver::publishStatus(const ros::Time& now) {
   {
     std::lock_guard<std::mutex> lock(*mutex_);
     s->header.stamp = now;
-    s->header.frame_id = map_frame_;
+    s->header.frame_id = limits_.map_frame;
     for (auto& v : vehicles_) {
       v->c.stale = staleLocked(v.get(), wall);
       v->c.lag_max = v->lag_max_period;
@@ -223,8 +246,9 @@ void FleetReceiver::diagnose(const Vehicle* v, diagnostic_updater::DiagnosticSta
   std::lock_guard<std::mutex> lock(*mutex_);
   const ros::WallTime now = ros::WallTime::now();
   const wavog_mapping::VehicleStatus& c = v->c;
-  const std::uint64_t refused = c.dropped_version + c.dropped_frame + c.dropped_bad_pose +
-                                c.dropped_bad_size + c.dropped_refused + c.dropped_overflow;
+  const std::uint64_t refused = c.dropped_version + c.dropped_frame + c.dropped_bad_stamp +
+                                c.dropped_bad_pose + c.dropped_bad_size + c.dropped_refused +
+                                c.dropped_overflow;
   if (staleLocked(v, now)) {
     if (v->last_receipt.isZero()) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "stale: nothing received yet");
@@ -245,9 +269,12 @@ void FleetReceiver::diagnose(const Vehicle* v, diagnostic_updater::DiagnosticSta
   stat.add("integrated", c.integrated);
   stat.add("integrated late", c.integrated_late);
   stat.add("lost", c.lost);
+  stat.add("index regressions", c.index_regressions);
+  stat.add("index jumps", c.index_jumps);
   stat.add("dropped late", c.dropped_late);
   stat.add("dropped version", c.dropped_version);
   stat.add("dropped frame", c.dropped_frame);
+  stat.add("dropped bad stamp", c.dropped_bad_stamp);
   stat.add("dropped bad pose", c.dropped_bad_pose);
   stat.add("dropped bad size", c.dropped_bad_size);
   stat.add("dropped refused by core", c.dropped_refused);

@@ -2,7 +2,8 @@
 // (<ns>/fleet_scans, PlacedScan), each message checked (placed_scan.h), then held in a
 // ReorderBuffer and handed to the map in stamp order after at most fleet_reorder_wait (wall s);
 // late, foreign and overflowing messages are counted by vehicle and reason, warned with a
-// throttle. A vehicle silent for fleet_stale_timeout is stale (diagnostics WARN, ~fleet_status);
+// throttle; every stamp arithmetic is in double seconds (a hostile stamp cannot throw), and the
+// per-vehicle index sequence (stream_index.h) counts lost messages exactly. A vehicle silent for fleet_stale_timeout is stale (diagnostics WARN, ~fleet_status);
 // nothing waits for it, and its cells stay in the map like any region no longer observed.
 // Locking: every member is guarded by the mapper's one mutex (passed in), and the integration
 // callback runs under it.
@@ -20,6 +21,7 @@
 
 #include "placed_scan.h"
 #include "reorder_buffer.h"
+#include "stream_index.h"
 #include "wavog_mapping/FleetStatus.h"
 #include "wavog_mapping/PlacedScan.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -33,10 +35,10 @@ using IntegrateFn = std::function<wavog::IntegrateStats(const wavog::Pose2&, con
 class FleetReceiver {
  public:
   /// Subscribes to every vehicle of `ros.fleet_vehicles` (relative to `nh`); adds one diagnostics
-  /// task per vehicle to `updater`; publishes ~fleet_status on `pnh`. Throws
-  /// std::invalid_argument if the list is empty.
+  /// task per vehicle to `updater`; publishes ~fleet_status on `pnh`; `resolution`: the fleet
+  /// map's cell size (m), for the pose limits. Throws std::invalid_argument if the list is empty.
   FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh, const wavog_ros::RosParams& ros,
-                std::mutex* mutex, IntegrateFn integrate, diagnostic_updater::Updater* updater);
+                double resolution, std::mutex* mutex, IntegrateFn integrate, diagnostic_updater::Updater* updater);
   ~FleetReceiver();
 
   /// Scans integrated, all vehicles (under the mapper's lock).
@@ -62,7 +64,7 @@ class FleetReceiver {
   bool staleLocked(const Vehicle* v, const ros::WallTime& now) const;
 
   ros::NodeHandle nh_, pnh_;
-  std::string map_frame_;
+  PlacedScanLimits limits_;
   double stale_timeout_;
   bool integrate_late_;
   double reorder_wait_;

@@ -5,16 +5,18 @@
 #include <sstream>
 
 #include "wavog_mapping/core/limits.h"
+#include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_fleet {
 namespace {
 
-/// Largest |coordinate| (m) a fleet node takes; the core refuses a pose far inside it anyway.
-constexpr double kMaxCoordinate = 1e9;
-
-bool finitePose(double x, double y, double theta) {
-  return std::isfinite(x) && std::isfinite(y) && std::isfinite(theta) &&
-         std::abs(x) < kMaxCoordinate && std::abs(y) < kMaxCoordinate;
+/// The pose limits of the core, on every pose field of a message: finite, |theta| at most the
+/// core's largest |angle_min| (bearings theta + angle stay exact), the position inside the extent.
+bool poseInLimits(double x, double y, double theta, double resolution) {
+  const double extent = static_cast<double>(wavog::kCellIndexLimit);
+  // Negated comparisons: NaN is outside.
+  return !(std::abs(x) / resolution >= extent) && !(std::abs(y) / resolution >= extent) &&
+         std::isfinite(x) && std::isfinite(y) && std::abs(theta) <= wavog::kMaxAbsAngleMin;
 }
 
 }  // namespace
@@ -27,6 +29,8 @@ const char* toString(Refusal r) {
       return "version";
     case Refusal::kFrame:
       return "frame";
+    case Refusal::kBadStamp:
+      return "bad_stamp";
     case Refusal::kBadPose:
       return "bad_pose";
     case Refusal::kBadSize:
@@ -64,32 +68,52 @@ void fillPlacedScan(const ros::Time& stamp, const std::string& map_frame,
   m->ranges.assign(view.ranges, view.ranges + view.count);
 }
 
-Refusal checkPlacedScan(const wavog_mapping::PlacedScan& m, const std::string& map_frame,
-                        std::string* detail) {
+Refusal checkPlacedScan(const wavog_mapping::PlacedScan& m, const PlacedScanLimits& limits,
+                        const ros::Time& now, std::string* detail) {
   std::ostringstream d;
   Refusal r = Refusal::kNone;
+  const double offset = wavog_ros::secondsBetween(m.header.stamp, now);
+  const double n_beams = static_cast<double>(m.ranges.size());
   if (m.version != wavog_mapping::PlacedScan::FORMAT_VERSION) {
     d << "format version " << static_cast<int>(m.version) << ", this node reads "
       << static_cast<int>(wavog_mapping::PlacedScan::FORMAT_VERSION);
     r = Refusal::kVersion;
-  } else if (m.header.frame_id != map_frame) {
-    d << "frame_id '" << m.header.frame_id << "', the fleet maps in '" << map_frame << "'";
+  } else if (m.header.frame_id != limits.map_frame) {
+    d << "frame_id '" << m.header.frame_id << "', the fleet maps in '" << limits.map_frame << "'";
     r = Refusal::kFrame;
-  } else if (m.header.stamp.isZero() || !finitePose(m.x, m.y, m.theta) ||
-             !std::isfinite(m.angle_min) || !std::isfinite(m.angle_increment) ||
-             std::abs(m.angle_min) > wavog::kMaxAbsAngleMin ||
-             std::abs(m.angle_increment) < wavog::kMinAbsAngleIncrement) {
-    d << "pose (" << m.x << ", " << m.y << ", " << m.theta << "), angle_min " << m.angle_min
-      << ", angle_increment " << m.angle_increment << ", stamp " << m.header.stamp.sec << "."
-      << m.header.stamp.nsec;
+  } else if (m.header.stamp.isZero() || m.header.stamp.nsec >= 1000000000u ||
+             !(std::abs(offset) <= limits.max_stamp_offset)) {
+    d << "stamp " << m.header.stamp.sec << " s + " << m.header.stamp.nsec << " ns";
+    if (m.header.stamp.nsec >= 1000000000u) {
+      d << ": nsec not below 1e9";
+    } else {
+      d.precision(12);
+      d << ", " << offset << " s from the fleet node's clock (" << now.sec << "." << now.nsec
+        << " s), beyond fleet_max_stamp_offset " << limits.max_stamp_offset << " s";
+      if (now.isZero()) d << " (the clock reads 0: use_sim_time without /clock?)";
+    }
+    r = Refusal::kBadStamp;
+  } else if (!poseInLimits(m.x, m.y, m.theta, limits.resolution) ||
+             !poseInLimits(m.start_x, m.start_y, m.start_theta, limits.resolution) ||
+             !poseInLimits(m.end_x, m.end_y, m.end_theta, limits.resolution)) {
+    d << "pose (" << m.x << ", " << m.y << ", " << m.theta << "), start (" << m.start_x << ", "
+      << m.start_y << ", " << m.start_theta << "), end (" << m.end_x << ", " << m.end_y << ", "
+      << m.end_theta << "): each must be finite, |theta| <= " << wavog::kMaxAbsAngleMin
+      << " rad, |x|, |y| < " << static_cast<double>(wavog::kCellIndexLimit) * limits.resolution
+      << " m (the map's extent)";
     r = Refusal::kBadPose;
   } else if (m.ranges.empty() || m.ranges.size() > wavog::kMaxBeams ||
-             std::abs(m.angle_increment) * static_cast<double>(m.ranges.size() - 1) >
-                 2.0 * M_PI + 1e-6 ||
-             !(m.range_min >= 0.0) || !(m.range_max > m.range_min)) {
-    d << m.ranges.size() << " beams over " << std::abs(m.angle_increment) *
-                                                  static_cast<double>(m.ranges.size())
-      << " rad, range limits [" << m.range_min << ", " << m.range_max << "]";
+             !(std::abs(m.angle_min) <= wavog::kMaxAbsAngleMin) ||
+             !(std::abs(m.angle_increment) >= wavog::kMinAbsAngleIncrement) ||
+             !std::isfinite(m.angle_increment) ||
+             std::abs(m.angle_increment) * n_beams > 2.0 * M_PI + 1e-6 ||
+             !(m.range_min >= 0.0) || !std::isfinite(m.range_min) ||
+             !(m.range_max > m.range_min)) {
+    d << m.ranges.size() << " beams from angle_min " << m.angle_min << " by angle_increment "
+      << m.angle_increment << " rad, range limits [" << m.range_min << ", " << m.range_max
+      << "]: the core takes 1 to " << wavog::kMaxBeams << " beams, |angle_min| <= "
+      << wavog::kMaxAbsAngleMin << " rad, |angle_increment| >= " << wavog::kMinAbsAngleIncrement
+      << " rad, beams x |angle_increment| <= 2 pi, range_max > range_min >= 0";
     r = Refusal::kBadSize;
   }
   if (detail) *detail = d.str();

@@ -15,15 +15,27 @@
 
 namespace wavog_fleet {
 
-/// Why a fleet node refuses a PlacedScan (before the core sees it). Order = VehicleStatus fields.
+/// Why a fleet node refuses a PlacedScan (before the core sees it), checked in this order; each
+/// one is a VehicleStatus counter (dropped_<name>). The limits: docs/fleet.md.
 enum class Refusal {
   kNone,
-  kVersion,  ///< another format version
-  kFrame,    ///< not in the fleet's map frame
-  kBadPose,  ///< non-finite pose or angles, zero stamp
-  kBadSize,  ///< no beams, too many beams, bad range limits
+  kVersion,   ///< another format version
+  kFrame,     ///< not in the fleet's map frame
+  kBadStamp,  ///< stamp 0, nsec >= 1e9, or farther than max_stamp_offset from the fleet's clock
+  kBadPose,   ///< a pose field (x, y, theta, start_*, end_*) not finite or outside the limits
+  kBadSize,   ///< the scan geometry outside the core's limits (beams, angles, range limits)
 };
 const char* toString(Refusal r);
+
+/// What checkPlacedScan() holds a message against.
+struct PlacedScanLimits {
+  std::string map_frame = "map";  ///< the fleet's map frame
+  /// The fleet map's cell size (m): a pose coordinate must lie in the core's extent,
+  /// |x| / resolution < kCellIndexLimit (limits.h).
+  double resolution = 0.05;
+  /// Largest |stamp - the fleet node's clock| (s), fleet_max_stamp_offset.
+  double max_stamp_offset = 60.0;
+};
 
 /// Fills everything but header.seq: the scan stamped `stamp` of `input`, integrated from `pose`
 /// with `view` (the beams after mirroring and motion compensation), placed between `start` and
@@ -34,9 +46,11 @@ void fillPlacedScan(const ros::Time& stamp, const std::string& map_frame,
                     const wavog::Pose2& start, const wavog::Pose2& end,
                     wavog_mapping::PlacedScan* m);
 
-/// Checks a received PlacedScan against the fleet's `map_frame`; kNone: usable.
-Refusal checkPlacedScan(const wavog_mapping::PlacedScan& m, const std::string& map_frame,
-                        std::string* detail);
+/// Checks a received PlacedScan against `limits` at the fleet clock's `now`; kNone: usable
+/// (then every stamp arithmetic of the fleet node on it fits ros::Time and ros::Duration).
+/// *detail (if not null): what was wrong, empty for kNone. Never throws.
+Refusal checkPlacedScan(const wavog_mapping::PlacedScan& m, const PlacedScanLimits& limits,
+                        const ros::Time& now, std::string* detail);
 
 /// The core call's arguments; `m` must outlive the view.
 wavog::Pose2 placedPose(const wavog_mapping::PlacedScan& m);
