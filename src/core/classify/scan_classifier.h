@@ -74,8 +74,6 @@ class ScanClassifier {
   std::uint32_t hitMask4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const;
   long beamOf(double dx, double dy) const;
   long sectorIn(double dx, double dy, const SquareInfo& box, int start) const;
-  template <typename Test>
-  static std::uint32_t distanceMask(const std::array<double, 16>& d2, Test test);
   int lastSurelyPast(double dx, double dy, double tol, int lo, int hi) const;
   int lastNotSurelyBefore(double dx, double dy, double tol, int lo, int hi) const;
   double nearest2(const Square& sq) const;

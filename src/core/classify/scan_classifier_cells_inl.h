@@ -94,8 +94,11 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
   CellMasks m;
   if (box.single) {  // one beam: distances alone
     const LeafTest t = s_.leaf[static_cast<std::size_t>(box.jlo)];
-    const std::uint32_t e = distanceMask(d2, [&](double v) { return v < t.e; });
-    const std::uint32_t o = distanceMask(d2, [&](double v) { return v <= t.o; });
+    std::array<double, 16> te, to;
+    te.fill(t.e);
+    to.fill(t.o);
+    const std::uint32_t e = compareMask16<true>(d2.data(), te.data());
+    const std::uint32_t o = compareMask16<false>(d2.data(), to.data());
     m.e = e & ~hit;
     m.o = (o & ~e) | hit;
     return m;
@@ -117,38 +120,26 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
   std::array<std::int32_t, 16> sector;
   const std::int32_t* sectors = table.data();
   for (std::size_t i = 0; i < 16; ++i) sector[i] = sectors[bucket[i]];
-  std::uint32_t unsure = 0;
-  for (std::size_t i = 0; i < 16; ++i) {
-    unsure |= static_cast<std::uint32_t>(sector[i] < 0) << i;
-  }
-  for (unsure &= ~hit & 0xFFFFu; unsure != 0; unsure &= unsure - 1) {
+  for (std::uint32_t unsure = negativeMask16(sector.data()) & ~hit; unsure != 0;
+       unsure &= unsure - 1) {
     const auto i = static_cast<unsigned>(__builtin_ctz(unsure));
     // Start from the sector of the bucket before (this one is near a boundary).
     const long j = sectorIn(dx[i & 3], dy[i >> 2], box, sectors[(bucket[i] - 1u) & table.mask()]);
     sector[i] = j < 0 || j >= s_.n ? s_.n : static_cast<std::int32_t>(j);
   }
-  // The leaf tests of each cell's beam (leaf[n]: never E, never O).
-  std::uint32_t e = 0, o = 0;
+  // The leaf tests of each cell's beam (leaf[n]: never E, never O; a hit cell's is not used).
+  std::array<double, 16> te, to;
   const LeafTest* leaf = s_.leaf.data();
   for (std::size_t i = 0; i < 16; ++i) {
-    const LeafTest t = leaf[static_cast<std::size_t>(std::max(sector[i], 0))];
-    e |= static_cast<std::uint32_t>(d2[i] < t.e) << i;
-    o |= static_cast<std::uint32_t>(d2[i] <= t.o) << i;
+    const LeafTest& t = leaf[static_cast<std::size_t>(std::max(sector[i], 0))];
+    te[i] = t.e;
+    to[i] = t.o;
   }
+  const std::uint32_t e = compareMask16<true>(d2.data(), te.data());
+  const std::uint32_t o = compareMask16<false>(d2.data(), to.data());
   m.e = e & ~hit;
   m.o = (o & ~e) | hit;
   return m;
-}
-
-/// Bit i set where test(d2[i]) holds, for the 16 cells (the comparisons vectorise).
-template <typename Test>
-[[gnu::always_inline]] inline std::uint32_t ScanClassifier::distanceMask(
-    const std::array<double, 16>& d2, Test test) {
-  std::array<std::uint32_t, 16> bits;
-  for (std::size_t i = 0; i < 16; ++i) bits[i] = static_cast<std::uint32_t>(test(d2[i])) << i;
-  std::uint32_t mask = 0;
-  for (std::size_t i = 0; i < 16; ++i) mask |= bits[i];
-  return mask;
 }
 
 /// lround((normalise(atan2(dy, dx) - theta) - amin) / inc), as the reference computes it: the

@@ -2,9 +2,10 @@
 // pseudo-bearing (dy / (|dx| + |dy|) per half-plane, one division), built once per scan
 // geometry (beams, angle_min, angle_increment) and kept while it does not change. A bucket of
 // the table that no sector boundary comes near holds the sector of every direction in it,
-// exactly: the one the reference's lround gives (ALGORITHM.md 3.1). The other buckets (a boundary within
-// kPseudoMargin) say kUnsure, and the classifier decides those directions as before (boundary
-// cross products, or the bearing). Not installed; included only by src/core/*, the core tests.
+// exactly: the one the reference's lround gives (ALGORITHM.md 3.1). The other buckets (a
+// boundary within kPseudoMargin) say kUnsure, and the classifier decides those directions as
+// before (boundary cross products, or the bearing). Not installed; included only by src/core/*
+// and the core tests.
 #ifndef WAVOG_MAPPING_SRC_CORE_CLASSIFY_SECTOR_TABLE_H_
 #define WAVOG_MAPPING_SRC_CORE_CLASSIFY_SECTOR_TABLE_H_
 
