@@ -7,9 +7,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <string>
 
 #include "../../src/core/classify/scan_classifier.h"
+#include "../../src/core/classify/sector_table.h"
 #include "dense_reference.h"
 #include "test_support.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -180,6 +182,57 @@ TEST(ScanClassifier, RefusedScansAgreeWithTheReference) {
   EXPECT_TRUE(ref.prepare(p, {0, 0, 0}, good));
   EXPECT_FALSE(ref.prepare(p, {0, 0, 0}, zero_inc));
   EXPECT_FALSE(ref.prepare(p, {0, 0, 0}, none_valid));
+}
+
+// The pseudo-bearing table alone: every sector it gives is the reference's lround of the bearing
+// (n for outside the fan), also a hair beside a boundary and across the seam of a whole turn;
+// and it leaves few directions unsure.
+TEST(SectorTable, SureBucketsGiveTheReferenceBeam) {
+  struct Geometry {
+    int n;
+    double amin, inc;
+  };
+  const double pi = 3.14159265358979323846;
+  const Geometry geometries[] = {{361, -pi / 2, pi / 360},        // LMS-291, 180 deg
+                                 {360, -pi / 2, pi / 360},        // fr079
+                                 {1081, -2.35619449, 0.00436332}, // 270 deg
+                                 {720, -pi, 2 * pi / 720},        // a whole turn
+                                 {720, -pi, 2 * pi / 720 + 1e-9}, // slightly more than a turn
+                                 {16, 1.0, 0.2},                  // coarse
+                                 {5, 7.5, 0.01}};                 // angle_min beyond 2 pi
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(-pi, pi), unit(0.0, 1.0);
+  for (const Geometry& g : geometries) {
+    wavog::detail::SectorTable table;
+    table.prepare(g.n, g.amin, g.inc);
+    const double seam = 0.5 * (g.amin + g.amin + g.inc * (g.n - 1)) - pi;
+    const auto reference = [&](double dx, double dy) {
+      double beta = std::atan2(dy, dx);
+      beta -= 2 * pi * std::floor((beta - seam) / (2 * pi));
+      const long j = std::lround((beta - g.amin) / g.inc);
+      return j < 0 || j >= g.n ? g.n : static_cast<int>(j);
+    };
+    std::size_t sure = 0, count = 0;
+    for (int i = 0; i < 200000; ++i) {
+      double a;
+      if (i % 2 == 0) {
+        a = angle(rng);
+      } else {  // a hair from a boundary: 1e-12 .. 1e-6 rad either side
+        const int k = static_cast<int>(unit(rng) * (g.n + 1));
+        const double off = std::pow(10.0, -12.0 + 6.0 * unit(rng)) * (unit(rng) < 0.5 ? -1 : 1);
+        a = g.amin + (k - 0.5) * g.inc + off;
+      }
+      const double r = 0.01 + 100.0 * unit(rng);
+      const double dx = r * std::cos(a), dy = r * std::sin(a);
+      const std::int32_t got = table.sector(dx, dy);
+      count += i % 2 == 0 ? 1 : 0;
+      if (got == wavog::detail::SectorTable::kUnsure) continue;
+      sure += i % 2 == 0 ? 1 : 0;
+      ASSERT_EQ(got, reference(dx, dy)) << "n " << g.n << " inc " << g.inc << " angle " << a;
+    }
+    // Of the directions drawn anywhere, at most a sixth are unsure (near a boundary).
+    EXPECT_GT(static_cast<double>(sure), 0.83 * static_cast<double>(count)) << "n " << g.n;
+  }
 }
 
 }  // namespace

@@ -50,6 +50,7 @@ ScanStatus PreparedScan::prepare(const MapParams& params, const Pose2& pose, con
   }
   setGeometry(pose, scan, cell);
   setBoundaries();
+  sectors.prepare(n, amin, inc);
   setBeams(limits, scan, st);
   if (invalid_prefix[static_cast<std::size_t>(n)] == n) return ScanStatus::kNoValidBeam;
   std::sort(hits.begin(), hits.end());
@@ -78,6 +79,8 @@ void PreparedScan::setGeometry(const Pose2& pose, const ScanView& scan, double r
   seam = 0.5 * (amin + amax) - kPi;
   fast_guard = kFastAtanError / inc + kIndexSlack;
   seam_map = std::remainder(theta + seam, kTwoPi);
+  cos_theta = std::cos(theta);
+  sin_theta = std::sin(theta);
   inv_inc = 1.0 / inc;
   t_seam = (seam - amin) / inc;
 }
@@ -128,7 +131,8 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
   const double clear = limits.clear;
   const double inf = std::numeric_limits<double>::infinity();
   kind.assign(nu, BeamKind::kInvalid);
-  leaf.resize(nu);  // every element is written below
+  leaf.resize(nu + 1);  // every element is written below
+  leaf[nu] = LeafTest{};  // outside the fan: never E, never O
   // Level 0 of the tables is written below, the levels above by buildTables(). Sized once per
   // scan without clearing (a resize to the same size touches nothing).
   tableLevels();
@@ -136,6 +140,10 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
   hits.clear();
   hit_x.assign(nu, 0);
   hit_y.assign(nu, 0);
+  hit_group.assign(nu, 0);
+  hit_bit.assign(nu, 0);
+  group_x0 = static_cast<std::int64_t>(std::floor(px / res)) >> 2;
+  group_y0 = static_cast<std::int64_t>(std::floor(py / res)) >> 2;
   end_x.resize(nu);  // written for the hit beams below
   end_y.resize(nu);
   reach = 0.0;
@@ -163,6 +171,8 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
       hit_x[j] = static_cast<std::int64_t>(std::floor(ex / res));
       hit_y[j] = static_cast<std::int64_t>(std::floor(ey / res));
       hits.push_back(cellKey(hit_x[j], hit_y[j]));
+      hit_group[j] = groupKey(hit_x[j], hit_y[j]);
+      hit_bit[j] = 1u << ((hit_x[j] & 3) + 4 * (hit_y[j] & 3));
     }
     const bool valid = kind[j] != BeamKind::kInvalid;
     min_e2[j] = squaredLimit(ze);
@@ -198,6 +208,7 @@ void PreparedScan::buildTables() {
 }
 
 void PreparedScan::releaseIfLarge() {
+  if (sectors.buckets() > kKeepBuckets) sectors.release();
   if (ranges_.capacity() <= kScratchKeepBeams) return;
   const auto release = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
   release(ranges_);
@@ -213,6 +224,8 @@ void PreparedScan::releaseIfLarge() {
   release(max_u2);
   release(bnd_x);
   release(bnd_y);
+  release(hit_group);
+  release(hit_bit);
 }
 
 }  // namespace detail

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "classify/scan_numerics.h"
+#include "classify/sector_table.h"
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/types.h"
 
@@ -51,9 +52,10 @@ struct PreparedScan {
   double inv_inc = 0;     ///< 1 / inc
   double t_seam = 0;      ///< (seam - amin) / inc
   double fast_guard = 0;  ///< |t - (j + 1/2)| beyond which fastAtan2 gives lround(t)
+  double cos_theta = 1, sin_theta = 0;  ///< rotate map-frame offsets into the sensor frame
 
   std::vector<BeamKind> kind;              ///< per beam
-  std::vector<LeafTest> leaf;              ///< per beam: exact leaf thresholds
+  std::vector<LeafTest> leaf;  ///< per beam: exact leaf thresholds; leaf[n]: outside (never E, O)
   std::vector<std::int64_t> hit_x, hit_y;  ///< per beam: the cell of its endpoint (hit beams)
   std::vector<double> end_x, end_y;        ///< per beam: its endpoint, map frame (hit beams)
   std::vector<std::uint64_t> hits;         ///< sorted cellKey()s of the hit endpoints
@@ -62,6 +64,11 @@ struct PreparedScan {
   /// (n per level); level 0 holds each beam's own squared limits (squaredLimit; -1 for none).
   std::vector<double> min_e2, max_u2;
   std::vector<double> bnd_x, bnd_y;  ///< boundary k between sectors k-1 and k: unit direction
+  SectorTable sectors;  ///< sector of a sensor-frame direction, kept while the geometry is
+  /// Per beam: the hit cell's 4 x 4 group as groupKey() and its bit x + 4 y in the group (0
+  /// for a beam without a hit), so a group gathers its hits without a branch.
+  std::vector<std::uint32_t> hit_group, hit_bit;
+  std::int64_t group_x0 = 0, group_y0 = 0;  ///< the sensor's 4 x 4 group (cells / 4, floored)
 
   /// Squared E and U limits of beam j.
   double e2(std::size_t j) const { return min_e2[j]; }
@@ -89,6 +96,20 @@ struct PreparedScan {
     return kind[j] == BeamKind::kHit && hit_x[j] == ix && hit_y[j] == iy;
   }
 
+  /// The 4 x 4 group of cells holding cell (ix, iy) as 16 + 16 bits relative to the sensor's:
+  /// distinct for every group within 2^17 cells of the sensor (the hard range limit is 2^16).
+  std::uint32_t groupKey(std::int64_t ix, std::int64_t iy) const {
+    const auto gx = static_cast<std::uint32_t>((ix >> 2) - group_x0) & 0xFFFFu;
+    const auto gy = static_cast<std::uint32_t>((iy >> 2) - group_y0) & 0xFFFFu;
+    return gx | (gy << 16);
+  }
+  /// The sensor-frame components of map-frame offset (dx, dy).
+  double sensorX(double dx, double dy) const { return cos_theta * dx + sin_theta * dy; }
+  double sensorY(double dx, double dy) const { return cos_theta * dy - sin_theta * dx; }
+  /// The sector of map-frame offset (dx, dy) from the table (n: outside the fan), or kUnsure.
+  std::int32_t tableSector(double dx, double dy) const {
+    return sectors.sector(sensorX(dx, dy), sensorY(dx, dy));
+  }
   static std::uint64_t cellKey(std::int64_t ix, std::int64_t iy) {
     return (static_cast<std::uint64_t>(ix + (std::int64_t{1} << 31)) << 32) ^
            static_cast<std::uint64_t>(iy + (std::int64_t{1} << 31));
@@ -107,6 +128,8 @@ struct PreparedScan {
   }
 
  private:
+  /// releaseIfLarge() frees a pseudo-bearing table of more buckets (a beam step under 1e-3 rad).
+  static constexpr std::size_t kKeepBuckets = 8192;
   void setGeometry(const Pose2& pose, const ScanView& scan, double res);
   void setBoundaries();
   /// The range limits of one scan's beams (m): no return at or beyond sensor_max, the given

@@ -9,6 +9,7 @@
 #ifndef WAVOG_MAPPING_SRC_CORE_CLASSIFY_SCAN_CLASSIFIER_H_
 #define WAVOG_MAPPING_SRC_CORE_CLASSIFY_SCAN_CLASSIFIER_H_
 
+#include <array>
 #include <cstdint>
 #include <limits>
 
@@ -67,20 +68,14 @@ class ScanClassifier {
   struct Square {
     double x0, y0, x1, y1;
   };
-  /// Up to this many boundaries, beamIn() tests each one; beyond, it bisects.
-  static constexpr int kLinearSectors = 4;
-  /// Returned by linearSector() when a boundary is too close to tell.
-  static constexpr long kUnsure = std::numeric_limits<long>::min();
 
   CellClass cellAt(std::size_t j, double d2) const;
   bool isHitCell(std::int64_t ix, std::int64_t iy, const SquareInfo& box) const;
   std::uint32_t hitMask4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const;
   long beamOf(double dx, double dy) const;
-  long beamIn(double dx, double dy, const SquareInfo& box) const;
+  long sectorIn(double dx, double dy, const SquareInfo& box, int start) const;
   int lastSurelyPast(double dx, double dy, double tol, int lo, int hi) const;
   int lastNotSurelyBefore(double dx, double dy, double tol, int lo, int hi) const;
-  template <typename Cross>
-  static long linearSector(int slo, int nb, double tol, Cross cross);
   double nearest2(const Square& sq) const;
   double farthest2(const Square& sq) const;
   Square square(int l, std::int64_t ix0, std::int64_t iy0) const;

@@ -31,7 +31,8 @@ inline CellClass ScanClassifier::classifyCell(std::int64_t ix, std::int64_t iy,
     if (s_.hitsCell(ju, ix, iy)) return CellClass::kOccupied;
   } else {
     if (isHitCell(ix, iy, box)) return CellClass::kOccupied;
-    const long j = box.narrow ? beamIn(dx, dy, box) : beamOf(dx, dy);
+    long j = s_.tableSector(dx, dy);  // exact, unless kUnsure
+    if (j < 0) j = box.narrow ? sectorIn(dx, dy, box, box.slo) : beamOf(dx, dy);
     if (j < 0 || j >= s_.n) return CellClass::kUnknown;
     ju = static_cast<std::size_t>(j);
   }
@@ -58,21 +59,25 @@ inline bool ScanClassifier::isHitCell(std::int64_t ix, std::int64_t iy,
   return false;
 }
 
-/// The cells of the 4 x 4 square at (ix0, iy0) holding a hit endpoint of the square's beams.
+/// The cells of the 4 x 4 square at (ix0, iy0) (a multiple of 4 each) holding a hit endpoint of
+/// the square's beams: a compare and a mask per beam, without a branch (vectorised).
 [[gnu::always_inline]] inline std::uint32_t ScanClassifier::hitMask4x4(
     std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const {
+  const std::uint32_t key = s_.groupKey(ix0, iy0);
+  const std::uint32_t* group = s_.hit_group.data();
+  const std::uint32_t* bit = s_.hit_bit.data();
   std::uint32_t hit = 0;
   for (int j = box.jlo; j <= box.jhi; ++j) {
     const auto ju = static_cast<std::size_t>(j);
-    if (s_.kind[ju] != BeamKind::kHit) continue;
-    const std::int64_t hx = s_.hit_x[ju] - ix0, hy = s_.hit_y[ju] - iy0;
-    if (hx >= 0 && hx < 4 && hy >= 0 && hy < 4) hit |= 1u << (hx + 4 * hy);
+    hit |= group[ju] == key ? bit[ju] : 0u;
   }
   return hit;
 }
 
-/// Distances and cross products are separable over the grid's 4 columns and 4 rows, and the
-/// hits of the square's beams are gathered once.
+/// Distances are separable over the grid's 4 columns and 4 rows; every cell finds its sector in
+/// the pseudo-bearing table (exact, no trigonometry), and only a cell in a bucket near a boundary
+/// (about one in 10-20) tests the boundaries (sectorIn). The loops over the 16 cells are
+/// branch-free; the hits of the square's beams are gathered once.
 inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
                                              const SquareInfo& box) const {
   // The reference's arithmetic: dx = (ix + 1/2) res - px, d2 = dx dx + dy dy.
@@ -83,68 +88,57 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
     dx2[i] = dx[i] * dx[i];
     dy2[i] = dy[i] * dy[i];
   }
+  std::array<double, 16> d2;
+  for (std::size_t i = 0; i < 16; ++i) d2[i] = dx2[i & 3] + dy2[i >> 2];
   const std::uint32_t hit = hitMask4x4(ix0, iy0, box);
+  CellMasks m;
   if (box.single) {  // one beam: distances alone
     const LeafTest t = s_.leaf[static_cast<std::size_t>(box.jlo)];
-    std::uint32_t e = 0, o = 0;
-    for (unsigned i = 0; i < 16; ++i) {
-      const double d2 = dx2[i & 3] + dy2[i >> 2];
-      e |= static_cast<std::uint32_t>(d2 < t.e) << i;
-      o |= static_cast<std::uint32_t>(d2 <= t.o) << i;
-    }
-    CellMasks m;
+    std::array<double, 16> te, to;
+    te.fill(t.e);
+    to.fill(t.o);
+    const std::uint32_t e = compareMask16<true>(d2.data(), te.data());
+    const std::uint32_t o = compareMask16<false>(d2.data(), to.data());
     m.e = e & ~hit;
     m.o = (o & ~e) | hit;
     return m;
   }
-  // A few sectors. Where the distance alone decides (E in every sector of the square, or U in
-  // every one: outside sectors and invalid beams count as U), no sector is needed.
-  double te_min =
-      box.slo < 0 || box.shi > s_.n - 1 ? -1.0 : std::numeric_limits<double>::infinity();
-  double te_max = -1.0, tu_max = -1.0;
-  for (int j = box.jlo; j <= box.jhi; ++j) {
-    const LeafTest& t = s_.leaf[static_cast<std::size_t>(j)];
-    te_min = std::min(te_min, t.e);
-    te_max = std::max(te_max, t.e);
-    tu_max = std::max(tu_max, t.o);
+  // Each cell's sector (n: outside the fan) from its bucket, or kUnsure. The sensor-frame
+  // offsets are separable too.
+  std::array<double, 4> cx, sx, cy, sy;
+  for (std::size_t i = 0; i < 4; ++i) {
+    cx[i] = s_.cos_theta * dx[i];
+    sx[i] = s_.sin_theta * dx[i];
+    cy[i] = s_.cos_theta * dy[i];
+    sy[i] = s_.sin_theta * dy[i];
   }
-  CellMasks m;
-  m.o = hit;
-  // Up to kLinearSectors boundaries, their cross products' two terms are separable too: the
-  // same products beamIn() forms, computed once per row and column.
-  const int nb = box.shi - box.slo;
-  std::array<std::array<double, 4>, kLinearSectors> bxdy, bydx;
-  if (nb <= kLinearSectors) {
-    for (int b = 0; b < nb; ++b) {
-      const auto ku = static_cast<std::size_t>(box.slo + 1 + b), bu = static_cast<std::size_t>(b);
-      for (std::size_t t = 0; t < 4; ++t) {
-        bxdy[bu][t] = s_.bnd_x[ku] * dy[t];
-        bydx[bu][t] = s_.bnd_y[ku] * dx[t];
-      }
-    }
+  const SectorTable& table = s_.sectors;
+  std::array<std::uint32_t, 16> bucket;
+  for (std::size_t i = 0; i < 16; ++i) {
+    bucket[i] = table.bucket(cx[i & 3] + sy[i >> 2], cy[i >> 2] - sx[i & 3]);
   }
-  for (unsigned i = 0; i < 16; ++i) {
-    if ((hit >> i) & 1u) continue;
-    const unsigned c = i & 3, r = i >> 2;
-    const double d2 = dx2[c] + dy2[r];
-    if (d2 < te_min) {
-      m.e |= 1u << i;
-      continue;
-    }
-    if (d2 >= te_max && d2 > tu_max) continue;  // U
-    long j;
-    if (nb <= kLinearSectors) {  // beamIn()'s linear test, on the stored products
-      j = linearSector(box.slo, nb, kRayMargin * (std::fabs(dx[c]) + std::fabs(dy[r])),
-                       [&](std::size_t b) { return bxdy[b][r] - bydx[b][c]; });
-      if (j == kUnsure) j = beamOf(dx[c], dy[r]);
-    } else {
-      j = beamIn(dx[c], dy[r], box);
-    }
-    if (j < 0 || j >= s_.n) continue;  // outside the fan: U
-    const CellClass cls = cellAt(static_cast<std::size_t>(j), d2);
-    m.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << i;
-    m.o |= static_cast<std::uint32_t>(cls == CellClass::kOccupied) << i;
+  std::array<std::int32_t, 16> sector;
+  const std::int32_t* sectors = table.data();
+  for (std::size_t i = 0; i < 16; ++i) sector[i] = sectors[bucket[i]];
+  for (std::uint32_t unsure = negativeMask16(sector.data()) & ~hit; unsure != 0;
+       unsure &= unsure - 1) {
+    const auto i = static_cast<unsigned>(__builtin_ctz(unsure));
+    // Start from the sector of the bucket before (this one is near a boundary).
+    const long j = sectorIn(dx[i & 3], dy[i >> 2], box, sectors[(bucket[i] - 1u) & table.mask()]);
+    sector[i] = j < 0 || j >= s_.n ? s_.n : static_cast<std::int32_t>(j);
   }
+  // The leaf tests of each cell's beam (leaf[n]: never E, never O; a hit cell's is not used).
+  std::array<double, 16> te, to;
+  const LeafTest* leaf = s_.leaf.data();
+  for (std::size_t i = 0; i < 16; ++i) {
+    const LeafTest& t = leaf[static_cast<std::size_t>(std::max(sector[i], 0))];
+    te[i] = t.e;
+    to[i] = t.o;
+  }
+  const std::uint32_t e = compareMask16<true>(d2.data(), te.data());
+  const std::uint32_t o = compareMask16<false>(d2.data(), to.data());
+  m.e = e & ~hit;
+  m.o = (o & ~e) | hit;
   return m;
 }
 
@@ -191,46 +185,42 @@ inline int ScanClassifier::lastNotSurelyBefore(double dx, double dy, double tol,
   return lo;
 }
 
-/// The sector, among slo..slo + nb, of a direction whose cross product with boundary
-/// slo + 1 + b is cross(b): slo plus the boundaries it is surely past (by more than tol), if it
-/// is surely on one side of each and past none after one it is before; else kUnsure.
-template <typename Cross>
-inline long ScanClassifier::linearSector(int slo, int nb, double tol, Cross cross) {
-  long j = slo;
-  bool ok = true, before = false;
-  for (int b = 0; b < nb; ++b) {
-    const double x = cross(static_cast<std::size_t>(b));
-    if (x > tol) {
-      ok = ok && !before;
-      ++j;
-    } else if (x < -tol) {
-      before = true;
-    } else {
-      ok = false;
-    }
-  }
-  return ok ? j : kUnsure;
-}
-
-/// beamOf() for a cell of a narrow square: the last boundary it is surely past, unless it is
-/// too close to the next one to tell (then the reference's rounding decides, via beamOf). Up to
-/// kLinearSectors boundaries each one is tested (past the first j - slo of them, before the
-/// rest); beyond, they are bisected.
-inline long ScanClassifier::beamIn(double dx, double dy, const SquareInfo& box) const {
+/// beamOf() for a cell of a narrow square, without a bearing: sector `start` (clamped to the
+/// square's sectors slo..shi), moved to the neighbour while
+/// the cell is surely past the next boundary or surely before its own, and taken once it is
+/// surely past its own (or it is slo) and surely before the next (or it is shi). Within a narrow
+/// square the sides are monotone in the boundary, so this is the sector that testing every
+/// boundary would give; a cell too close to a boundary to tell gets the reference's rounding,
+/// via beamOf. Two cross products when the candidate is right.
+inline long ScanClassifier::sectorIn(double dx, double dy, const SquareInfo& box,
+                                     int start) const {
   const double tol = kRayMargin * (std::fabs(dx) + std::fabs(dy));
-  if (box.shi - box.slo <= kLinearSectors) {
-    const long j = linearSector(box.slo, box.shi - box.slo, tol, [&](std::size_t b) {
-      const std::size_t ku = static_cast<std::size_t>(box.slo) + 1 + b;
-      return s_.bnd_x[ku] * dy - s_.bnd_y[ku] * dx;
-    });
-    return j != kUnsure ? j : beamOf(dx, dy);
+  const double* bx = s_.bnd_x.data();
+  const double* by = s_.bnd_y.data();
+  const auto cross = [&](int k) {
+    const auto ku = static_cast<std::size_t>(k);
+    return bx[ku] * dy - by[ku] * dx;
+  };
+  int j = std::min(std::max(start, box.slo), box.shi);
+  for (;;) {
+    if (j < box.shi) {
+      const double next = cross(j + 1);
+      if (next > tol) {
+        ++j;
+        continue;
+      }
+      if (!(next < -tol)) return beamOf(dx, dy);
+    }
+    if (j > box.slo) {
+      const double own = cross(j);
+      if (own < -tol) {
+        --j;
+        continue;
+      }
+      if (!(own > tol)) return beamOf(dx, dy);
+    }
+    return j;
   }
-  const int j = lastSurelyPast(dx, dy, tol, box.slo, box.shi);
-  if (j < box.shi) {
-    const auto m = static_cast<std::size_t>(j + 1);
-    if (!(s_.bnd_x[m] * dy - s_.bnd_y[m] * dx < -tol)) return beamOf(dx, dy);
-  }
-  return j;
 }
 
 }  // namespace detail
