@@ -21,3 +21,10 @@ catkin_package(
                  message_runtime
   DEPENDS EIGEN3
 )
+
+# The tests' catkin packages: rostest (add_rostest, add_rostest_gtest) and roslaunch
+# (roslaunch_add_file_check), found once here for every fragment.
+if(CATKIN_ENABLE_TESTING)
+  find_package(rostest REQUIRED)
+  find_package(roslaunch REQUIRED)
+endif()

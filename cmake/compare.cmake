@@ -9,7 +9,6 @@ target_compile_options(wavog_baseline PRIVATE ${WAVOG_WARNINGS} -Wconversion)
 set_target_properties(wavog_baseline PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
 # ---- Baseline unit tests (ctest label "baseline"; no ROS, so they run under the sanitizers) ------
-find_package(GTest REQUIRED)
 add_executable(test_dense_grid test/baseline/test_dense_grid.cpp)
 target_link_libraries(test_dense_grid PRIVATE wavog_baseline GTest::GTest GTest::Main)
 target_compile_options(test_dense_grid PRIVATE ${WAVOG_WARNINGS})

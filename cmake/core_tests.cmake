@@ -1,7 +1,6 @@
 # Core unit tests: plain gtest executables registered with ctest, label "core". They need no ROS,
 # so they also run under the sanitizers (make test-asan).
 find_package(GTest REQUIRED)
-find_package(Threads REQUIRED)
 
 add_library(wavog_test_support STATIC test/core/dense_reference.cpp test/core/test_support.cpp)
 target_link_libraries(wavog_test_support PUBLIC wavog_core wavog_io GTest::GTest Threads::Threads

@@ -42,9 +42,7 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node
     DEPENDS wavog_simulate
     COMMENT "wavog_simulate: the fleet rostest's bag (3 vehicles, 28 s)")
   add_custom_target(wavog_fleet_test_bag ALL DEPENDS ${WAVOG_FLEET_BAG})
-  find_package(rostest REQUIRED)
   add_rostest_gtest(test_fleet_system test/fleet.test test/ros/test_fleet_system.cpp)
-  target_include_directories(test_fleet_system SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
   target_link_libraries(test_fleet_system wavog_ros_config wavog_sim wavog_core ${catkin_LIBRARIES}
                         ${GTEST_LIBRARIES})
   target_compile_definitions(test_fleet_system PRIVATE
@@ -57,9 +55,7 @@ endif()
 
 # ---- The fleet map as a nodelet (test/fleet_nodelet.test): placed scans from the test itself ------
 if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet_nodelet)
-  find_package(rostest REQUIRED)
   add_rostest_gtest(test_fleet_nodelet test/fleet_nodelet.test test/ros/test_fleet_nodelet.cpp)
-  target_include_directories(test_fleet_nodelet SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
   target_link_libraries(test_fleet_nodelet wavog_ros_config wavog_core ${catkin_LIBRARIES}
                         ${GTEST_LIBRARIES})
   target_compile_definitions(test_fleet_nodelet PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")

@@ -5,7 +5,9 @@
 # prints at the end. With WAVOG_REQUIRE_DATA=1 in the environment (CI), a missing file fails the
 # configuration instead.
 if(DEFINED ENV{WAVOG_DATA_DIR})
-  set(WAVOG_DATA_DIR $ENV{WAVOG_DATA_DIR})
+  # catkin_lint: the data lie outside the repository by design; CI and users point here at them.
+  #catkin_lint: ignore_once ENV_VAR
+  file(TO_CMAKE_PATH "$ENV{WAVOG_DATA_DIR}" WAVOG_DATA_DIR)
 else()
   get_filename_component(WAVOG_DATA_DIR ${CMAKE_CURRENT_SOURCE_DIR}/../shared/data ABSOLUTE)
 endif()

@@ -1,11 +1,17 @@
 # ROS layer: parameter loader, mapper (nodelet + node), rostests. Owned by the ROS layer.
 # Include paths are per target: ROS headers are SYSTEM, and wavog_core never sees them.
-set(WAVOG_ROS_INCLUDES ${catkin_INCLUDE_DIRS} ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
+# wavog_ros_includes carries them: ROS's headers and the generated ones (messages, services,
+# dynamic_reconfigure in the devel space), as SYSTEM includes, so the warning flags never apply to
+# generated code. Every ROS target links it (wavog_ros_config passes it on).
+add_library(wavog_ros_includes INTERFACE)
+# catkin_lint: the devel space's include folder is catkin's own (gencpp adds it too, not SYSTEM).
+#catkin_lint: ignore_once EXTERNAL_DIRECTORY EXTERNAL_INTERFACE_PATH
+target_include_directories(wavog_ros_includes SYSTEM INTERFACE ${catkin_INCLUDE_DIRS}
+                           ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
 
 # ---- wavog_ros_config: the one parameter loader (node, nodelet and offline tools) -------------
 add_library(wavog_ros_config src/ros/config.cpp)
-target_include_directories(wavog_ros_config SYSTEM PUBLIC ${WAVOG_ROS_INCLUDES})
-target_link_libraries(wavog_ros_config PUBLIC wavog_core ${catkin_LIBRARIES} PRIVATE yaml-cpp)
+target_link_libraries(wavog_ros_config PUBLIC wavog_ros_includes wavog_core ${catkin_LIBRARIES} PRIVATE yaml-cpp)
 target_compile_options(wavog_ros_config PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_ros_config PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
@@ -26,7 +32,6 @@ if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/mapping_ros.cpp)
     src/ros/mapping_ros_services.cpp
     src/ros/mapping_ros_flush.cpp
     src/ros/save_path.cpp)
-  target_include_directories(wavog_ros SYSTEM PUBLIC ${WAVOG_ROS_INCLUDES})
   target_link_libraries(wavog_ros PUBLIC wavog_ros_config wavog_io wavog_core ${catkin_LIBRARIES})
   target_compile_options(wavog_ros PRIVATE ${WAVOG_WARNINGS})
   set_target_properties(wavog_ros PROPERTIES POSITION_INDEPENDENT_CODE ON)
@@ -94,14 +99,11 @@ if(CATKIN_ENABLE_TESTING)
   # libraries, built after the messages and the node.
   function(wavog_rostest_gtest target launch source)
     add_rostest_gtest(${target} ${launch} ${source})
-    target_include_directories(${target} SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(${target} ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+    target_link_libraries(${target} wavog_ros_includes ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
     add_dependencies(${target} ${PROJECT_NAME}_generate_messages_cpp ${WAVOG_ROS_RUNTIME})
   endfunction()
 
   if(TARGET wavog_mapping_node)
-    find_package(rostest REQUIRED)
-    find_package(roslaunch REQUIRED)
     set(WAVOG_ROS_RUNTIME wavog_mapping_node wavog_mapping_nodelet)
 
     # Integration: the same gtest against the node and against the nodelet, plus hztests.
@@ -160,8 +162,7 @@ if(CATKIN_ENABLE_TESTING)
 
     # The test room as a standalone publisher (make rviz-check).
     add_executable(room_scene test/ros/room_scene.cpp)
-    target_include_directories(room_scene SYSTEM PRIVATE ${WAVOG_ROS_INCLUDES})
-    target_link_libraries(room_scene ${catkin_LIBRARIES})
+    target_link_libraries(room_scene wavog_ros_includes ${catkin_LIBRARIES})
     set_target_properties(room_scene PROPERTIES
       RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 

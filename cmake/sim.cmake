@@ -1,7 +1,5 @@
 # Simulation, scenario and policy evaluation (issue 5): wavog_sim (ROS-free: std + Eigen +
 # yaml-cpp), wavog_simulate (rosbag writer), wavog_evaluate, and their gtests (ctest label "sim").
-find_package(yaml-cpp REQUIRED)
-find_package(GTest REQUIRED)
 
 # Static: the installed tools then need no extra shared library.
 add_library(wavog_sim STATIC
@@ -24,8 +22,6 @@ endfunction()
 
 # Policy evaluation through the core map (links wavog_core for real).
 add_library(wavog_sim_eval STATIC src/sim/evaluation.cpp src/sim/noise_study.cpp)
-find_package(nlohmann_json 3 REQUIRED)
-find_package(Threads REQUIRED)
 target_link_libraries(wavog_sim_eval PUBLIC wavog_sim wavog_core
                       PRIVATE nlohmann_json::nlohmann_json Threads::Threads)
 target_compile_options(wavog_sim_eval PRIVATE ${WAVOG_WARNINGS})

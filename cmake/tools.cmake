@@ -19,7 +19,6 @@ if(TARGET wavog_ros AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/tools/offline.cpp
 endif()
 
 # ---- Tests: plain gtest executables (built by `make`, unlike catkin_add_gtest) run by ctest ----
-find_package(GTest REQUIRED)
 
 # wavog_tools_test(<name> [REAL_DATA <file>...]): as wavog_core_test (cmake/core_tests.cmake).
 function(wavog_tools_test name)
@@ -64,10 +63,7 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
    AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/tools/playback.test)
   wavog_real_data_found(_wavog_have_fr079 rostest_playback.test fr079-corrected.log.gz)
   if(_wavog_have_fr079)
-    find_package(rostest REQUIRED)
     add_executable(test_playback test/tools/test_playback.cpp)
-    target_include_directories(test_playback SYSTEM PRIVATE ${catkin_INCLUDE_DIRS}
-                               ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
     target_link_libraries(test_playback PRIVATE wavog_ros_config wavog_core ${catkin_LIBRARIES}
                           GTest::GTest)
     target_compile_options(test_playback PRIVATE ${WAVOG_WARNINGS})
@@ -96,11 +92,8 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_mapping_node
   set(_wavog_real_bag ${_wavog_data_dir}/laser_scan_matcher_demo.bag)
   wavog_real_data_found(_wavog_have_lsm rostest_real_bag.test laser_scan_matcher_demo.bag)
   if(_wavog_have_lsm)
-    find_package(rostest REQUIRED)
     add_executable(test_real_bag test/tools/test_real_bag.cpp)
-    target_include_directories(test_real_bag SYSTEM PRIVATE ${catkin_INCLUDE_DIRS}
-                               ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
-    target_link_libraries(test_real_bag PRIVATE ${catkin_LIBRARIES} GTest::GTest)
+    target_link_libraries(test_real_bag PRIVATE wavog_ros_includes ${catkin_LIBRARIES} GTest::GTest)
     target_compile_options(test_real_bag PRIVATE ${WAVOG_WARNINGS})
     set_target_properties(test_real_bag PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_TOOLS_BIN_DIR})
     add_dependencies(test_real_bag ${PROJECT_NAME}_generate_messages_cpp)
@@ -112,8 +105,6 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_mapping_node
 endif()
 
 # ---- wavog_paper (issue 17): the paper's figures from fr079 (make paper; no ROS at run time) ---
-find_package(CLI11 CONFIG REQUIRED)
-find_package(nlohmann_json 3 REQUIRED)
 add_executable(wavog_paper src/tools/paper.cpp)
 target_link_libraries(wavog_paper PRIVATE wavog_sim wavog_io wavog_tool_support CLI11::CLI11
                       nlohmann_json::nlohmann_json Threads::Threads)

@@ -23,6 +23,8 @@ PKGS=(
   rosbash python3-rospy python3-rosservice python3-rosparam python3-nav-msgs python3-sensor-msgs
   python3-map-msgs python3-std-srvs python3-diagnostic-msgs python3-geometry-msgs python3-std-msgs
   python3-visualization-msgs
+  # make lint: the package checked as released ROS packages are (catkin_lint -W1).
+  catkin-lint
 )
 # `install_deps.sh fuzz` (make fuzz): clang and its libFuzzer / sanitizer runtimes as well.
 if [ "${1:-}" = fuzz ]; then
