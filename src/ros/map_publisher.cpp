@@ -11,7 +11,6 @@
 #include <utility>
 
 #include "wavog_mapping/io/map_files.h"
-#include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_ros {
 namespace {
@@ -105,6 +104,27 @@ void MapPublisher::markAllDirty(double resolution) {
               m(last_full_box_.max_y)});
 }
 
+LayerSize readOccupancy(const wavog::WaveletMap& map, int scale, const RosParams& params, double cx,
+                        double cy, wavog::Raster* raster, std::string* refused) {
+  // With a window, the read-out costs what the window holds, never the whole map.
+  wavog::CellBox box;
+  const LayerSize size = layerBox(map, scale, params.publish_window, cx, cy, &box);
+  *raster = emptyRaster(scale, map.resolution());
+  if (size == LayerSize::kTooLarge) {
+    *refused = "scale " + std::to_string(scale) + ": " + std::to_string(box.width()) + " x " +
+               std::to_string(box.height()) + " cells";
+  }
+  if (size != LayerSize::kOk) return size;
+  const wavog::Aggregation aggregation =
+      scale == 0 ? wavog::Aggregation::kMean : params.scale_aggregation;
+  // Cut to the observed cells: stored blocks are whole (2^block_levels cells a side) and a
+  // window may reach beyond what was seen; neither belongs in the message.
+  wavog::Raster r = map.exportScale(scale, box, aggregation);
+  wavog::CellBox known;
+  if (wavog::knownBox(r, &known)) *raster = wavog::cropToKnown(r, 0);
+  return size;
+}
+
 Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params, double cx,
                           double cy) {
   Layers out;
@@ -129,23 +149,10 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
     }
   }
   for (Layers::Layer& layer : out.layers) {
-    // With a window, the read-out costs what the window holds, never the whole map.
-    wavog::CellBox box;
-    const LayerSize size = layerBox(map, layer.scale, params.publish_window, cx, cy, &box);
-    if (size == LayerSize::kTooLarge) {
-      out.refused.push_back("scale " + std::to_string(layer.scale) + ": " +
-                            std::to_string(box.width()) + " x " + std::to_string(box.height()) +
-                            " cells");
-    }
-    const wavog::Aggregation aggregation =
-        layer.scale == 0 ? wavog::Aggregation::kMean : params.scale_aggregation;
-    // Cut to the observed cells: stored blocks are whole (2^block_levels cells a side) and a
-    // window may reach beyond what was seen; neither belongs in the message.
-    wavog::CellBox known;
-    layer.raster = emptyRaster(layer.scale, map.resolution());
-    if (size == LayerSize::kOk) {
-      wavog::Raster r = map.exportScale(layer.scale, box, aggregation);
-      if (wavog::knownBox(r, &known)) layer.raster = wavog::cropToKnown(r, 0);
+    std::string refused;
+    if (readOccupancy(map, layer.scale, params, cx, cy, &layer.raster, &refused) ==
+        LayerSize::kTooLarge) {
+      out.refused.push_back(refused);
     }
     if (layer.reflection_pub) {
       layer.reflection = map.exportReflection(layer.scale, layer.raster.box);

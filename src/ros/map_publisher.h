@@ -2,8 +2,9 @@
 // around the robot or the whole map, and over the same boxes with MapParams::reflection the
 // `reflection` (latched) and reflection_scale_<s> layers, with MapParams::ndt the NDT cells as
 // ndt_markers / ndt_cells (latched) and ndt_markers_scale_<s> / ndt_cells_scale_<s>;
-// map_updates, the changed rectangle of the finest layer, from one dirty region. Reads happen under
-// the caller's lock (MappingRos::Impl::mutex_, which guards this object and the map); publish() and
+// map_updates, the changed rectangle of the finest layer, from one dirty region. readOccupancy()
+// reads one layer's occupancy as it is published. Reads happen under the caller's lock
+// (MappingRos::Impl::mutex_, which guards this object and the map); publish() and
 // publishUpdate() run without it.
 #ifndef WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
 #define WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
@@ -16,6 +17,7 @@
 
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/ros/config.h"
+#include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_ros {
 
@@ -47,6 +49,14 @@ struct Layers {
   std::vector<Layer> layers;
   std::vector<std::string> refused;  ///< one line per layer larger than kMaxLayerCells
 };
+
+/// The occupancy raster of one layer as it is published: the cells of layerBox() (the window
+/// around (cx, cy) when params.publish_window > 0, else the map's bounds) at `scale`, Haar mean at
+/// scale 0 and params.scale_aggregation above, cut to the observed cells (an empty raster when
+/// none is). kTooLarge: *raster is empty and *refused says the layer's size. Allocates no more
+/// than kMaxLayerCells cells. The map's lock is the caller's.
+LayerSize readOccupancy(const wavog::WaveletMap& map, int scale, const RosParams& params, double cx,
+                        double cy, wavog::Raster* raster, std::string* refused);
 
 class MapPublisher {
  public:

@@ -149,6 +149,10 @@ struct MappingRos::Impl {
 
   // ---- publication and status (mapping_ros_publish.cpp)
   void onPublishTimer(const ros::TimerEvent&);
+  /// The centre of publish_window: base_frame in map_frame from tf (latest); (0, 0) without a
+  /// window. False, with a throttled warning ending in `consequence`, when tf has no such pose.
+  /// Without the lock (tf2's buffer locks itself).
+  bool windowCentre(const char* consequence, double* cx, double* cy);
   /// Reads and publishes every layer and ~status now (timer, end of input, services).
   void publishAll();
   /// Publishes ~status alone (the end of the input when the map has not changed since).
