@@ -2,6 +2,7 @@
 #include "map_publisher.h"
 
 #include <map_msgs/OccupancyGridUpdate.h>
+#include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -47,6 +48,7 @@ MapPublisher::MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& sc
                            bool reflection, bool ndt)
     : nh_(nh), reflection_(reflection), ndt_(ndt) {
   map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
+  metadata_pub_ = nh_.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
   update_pub_ = nh_.advertise<map_msgs::OccupancyGridUpdate>("map_updates", 10);
   if (reflection_) reflection_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("reflection", 1, true);
   if (ndt_) {
@@ -133,6 +135,7 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
   // the box, publishing that only when it has listeners too.
   Layers::Layer finest;
   finest.pub = map_pub_;
+  finest.metadata_pub = metadata_pub_;
   finest.reflection_pub = reflection_pub_;
   finest.ndt_markers_pub = ndt_markers_pub_;
   finest.ndt_cells_pub = ndt_cells_pub_;
@@ -175,7 +178,11 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
 
 void MapPublisher::publish(const Layers& layers, const std::string& frame, const ros::Time& stamp) {
   for (const Layers::Layer& layer : layers.layers) {
-    if (layer.pub) layer.pub.publish(toOccupancyGridMsg(layer.raster, frame, stamp));
+    if (layer.pub) {
+      const nav_msgs::OccupancyGrid::Ptr grid = toOccupancyGridMsg(layer.raster, frame, stamp);
+      layer.pub.publish(grid);
+      if (layer.metadata_pub) layer.metadata_pub.publish(grid->info);
+    }
     if (layer.reflection_pub) {
       layer.reflection_pub.publish(toOccupancyGridMsg(layer.reflection, frame, stamp));
     }
