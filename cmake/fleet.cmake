@@ -61,3 +61,12 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet_nodelet)
   target_compile_definitions(test_fleet_nodelet PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
   add_dependencies(test_fleet_nodelet ${PROJECT_NAME}_generate_messages_cpp wavog_fleet_nodelet)
 endif()
+
+# ---- The fleet node's map_metadata and dynamic_map (test/fleet_map_services.test) ----------------
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet)
+  add_rostest_gtest(test_fleet_map_services test/fleet_map_services.test
+                    test/ros/test_fleet_map_services.cpp)
+  target_link_libraries(test_fleet_map_services wavog_ros_includes ${catkin_LIBRARIES}
+                        ${GTEST_LIBRARIES})
+  add_dependencies(test_fleet_map_services ${PROJECT_NAME}_generate_messages_cpp wavog_fleet)
+endif()

@@ -2,6 +2,7 @@
 #include "map_publisher.h"
 
 #include <map_msgs/OccupancyGridUpdate.h>
+#include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -11,7 +12,6 @@
 #include <utility>
 
 #include "wavog_mapping/io/map_files.h"
-#include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_ros {
 namespace {
@@ -48,6 +48,7 @@ MapPublisher::MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& sc
                            bool reflection, bool ndt)
     : nh_(nh), reflection_(reflection), ndt_(ndt) {
   map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
+  metadata_pub_ = nh_.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
   update_pub_ = nh_.advertise<map_msgs::OccupancyGridUpdate>("map_updates", 10);
   if (reflection_) reflection_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("reflection", 1, true);
   if (ndt_) {
@@ -105,6 +106,27 @@ void MapPublisher::markAllDirty(double resolution) {
               m(last_full_box_.max_y)});
 }
 
+LayerSize readOccupancy(const wavog::WaveletMap& map, int scale, const RosParams& params, double cx,
+                        double cy, wavog::Raster* raster, std::string* refused) {
+  // With a window, the read-out costs what the window holds, never the whole map.
+  wavog::CellBox box;
+  const LayerSize size = layerBox(map, scale, params.publish_window, cx, cy, &box);
+  *raster = emptyRaster(scale, map.resolution());
+  if (size == LayerSize::kTooLarge) {
+    *refused = "scale " + std::to_string(scale) + ": " + std::to_string(box.width()) + " x " +
+               std::to_string(box.height()) + " cells";
+  }
+  if (size != LayerSize::kOk) return size;
+  const wavog::Aggregation aggregation =
+      scale == 0 ? wavog::Aggregation::kMean : params.scale_aggregation;
+  // Cut to the observed cells: stored blocks are whole (2^block_levels cells a side) and a
+  // window may reach beyond what was seen; neither belongs in the message.
+  wavog::Raster r = map.exportScale(scale, box, aggregation);
+  wavog::CellBox known;
+  if (wavog::knownBox(r, &known)) *raster = wavog::cropToKnown(r, 0);
+  return size;
+}
+
 Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params, double cx,
                           double cy) {
   Layers out;
@@ -113,6 +135,7 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
   // the box, publishing that only when it has listeners too.
   Layers::Layer finest;
   finest.pub = map_pub_;
+  finest.metadata_pub = metadata_pub_;
   finest.reflection_pub = reflection_pub_;
   finest.ndt_markers_pub = ndt_markers_pub_;
   finest.ndt_cells_pub = ndt_cells_pub_;
@@ -129,23 +152,10 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
     }
   }
   for (Layers::Layer& layer : out.layers) {
-    // With a window, the read-out costs what the window holds, never the whole map.
-    wavog::CellBox box;
-    const LayerSize size = layerBox(map, layer.scale, params.publish_window, cx, cy, &box);
-    if (size == LayerSize::kTooLarge) {
-      out.refused.push_back("scale " + std::to_string(layer.scale) + ": " +
-                            std::to_string(box.width()) + " x " + std::to_string(box.height()) +
-                            " cells");
-    }
-    const wavog::Aggregation aggregation =
-        layer.scale == 0 ? wavog::Aggregation::kMean : params.scale_aggregation;
-    // Cut to the observed cells: stored blocks are whole (2^block_levels cells a side) and a
-    // window may reach beyond what was seen; neither belongs in the message.
-    wavog::CellBox known;
-    layer.raster = emptyRaster(layer.scale, map.resolution());
-    if (size == LayerSize::kOk) {
-      wavog::Raster r = map.exportScale(layer.scale, box, aggregation);
-      if (wavog::knownBox(r, &known)) layer.raster = wavog::cropToKnown(r, 0);
+    std::string refused;
+    if (readOccupancy(map, layer.scale, params, cx, cy, &layer.raster, &refused) ==
+        LayerSize::kTooLarge) {
+      out.refused.push_back(refused);
     }
     if (layer.reflection_pub) {
       layer.reflection = map.exportReflection(layer.scale, layer.raster.box);
@@ -168,7 +178,11 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
 
 void MapPublisher::publish(const Layers& layers, const std::string& frame, const ros::Time& stamp) {
   for (const Layers::Layer& layer : layers.layers) {
-    if (layer.pub) layer.pub.publish(toOccupancyGridMsg(layer.raster, frame, stamp));
+    if (layer.pub) {
+      const nav_msgs::OccupancyGrid::Ptr grid = toOccupancyGridMsg(layer.raster, frame, stamp);
+      layer.pub.publish(grid);
+      if (layer.metadata_pub) layer.metadata_pub.publish(grid->info);
+    }
     if (layer.reflection_pub) {
       layer.reflection_pub.publish(toOccupancyGridMsg(layer.reflection, frame, stamp));
     }

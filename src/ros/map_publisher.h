@@ -1,9 +1,11 @@
-// Publication of the map: the `map` layer (latched) and the map_scale_<s> layers, cut to a window
-// around the robot or the whole map, and over the same boxes with MapParams::reflection the
-// `reflection` (latched) and reflection_scale_<s> layers, with MapParams::ndt the NDT cells as
-// ndt_markers / ndt_cells (latched) and ndt_markers_scale_<s> / ndt_cells_scale_<s>;
-// map_updates, the changed rectangle of the finest layer, from one dirty region. Reads happen under
-// the caller's lock (MappingRos::Impl::mutex_, which guards this object and the map); publish() and
+// Publication of the map: the `map` layer (latched) with its `map_metadata` (latched) and the
+// map_scale_<s> layers, cut to a window around the robot or the whole map, and over the same
+// boxes with MapParams::reflection the `reflection` (latched) and reflection_scale_<s> layers,
+// with MapParams::ndt the NDT cells as ndt_markers / ndt_cells (latched) and
+// ndt_markers_scale_<s> / ndt_cells_scale_<s>; map_updates, the changed rectangle of the finest
+// layer, from one dirty region. readOccupancy() reads one layer's occupancy as it is published
+// (also for the dynamic_map service). Reads happen under the caller's lock
+// (MappingRos::Impl::mutex_, which guards this object and the map); publish() and
 // publishUpdate() run without it.
 #ifndef WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
 #define WAVOG_MAPPING_SRC_ROS_MAP_PUBLISHER_H_
@@ -16,6 +18,7 @@
 
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/ros/config.h"
+#include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_ros {
 
@@ -37,6 +40,7 @@ struct Layers {
   struct Layer {
     int scale = 0;
     ros::Publisher pub;              ///< occupancy; null when only its payloads are wanted
+    ros::Publisher metadata_pub;     ///< `map_metadata` (the finest layer only), else null
     ros::Publisher reflection_pub;   ///< null when its reflection is not wanted
     ros::Publisher ndt_markers_pub;  ///< null when its NDT markers are not wanted
     ros::Publisher ndt_cells_pub;    ///< null when its NDT cloud is not wanted
@@ -48,11 +52,19 @@ struct Layers {
   std::vector<std::string> refused;  ///< one line per layer larger than kMaxLayerCells
 };
 
+/// The occupancy raster of one layer as it is published: the cells of layerBox() (the window
+/// around (cx, cy) when params.publish_window > 0, else the map's bounds) at `scale`, Haar mean at
+/// scale 0 and params.scale_aggregation above, cut to the observed cells (an empty raster when
+/// none is). kTooLarge: *raster is empty and *refused says the layer's size. Allocates no more
+/// than kMaxLayerCells cells. The map's lock is the caller's.
+LayerSize readOccupancy(const wavog::WaveletMap& map, int scale, const RosParams& params, double cx,
+                        double cy, wavog::Raster* raster, std::string* refused);
+
 class MapPublisher {
  public:
-  /// Advertises map, map_updates and map_scale_<s> for `scales` on `nh`; with `reflection`, also
-  /// reflection and reflection_scale_<s>; with `ndt`, also ndt_markers, ndt_cells,
-  /// ndt_markers_scale_<s> and ndt_cells_scale_<s>.
+  /// Advertises map, map_metadata, map_updates and map_scale_<s> for `scales` on `nh`; with
+  /// `reflection`, also reflection and reflection_scale_<s>; with `ndt`, also ndt_markers,
+  /// ndt_cells, ndt_markers_scale_<s> and ndt_cells_scale_<s>.
   MapPublisher(const ros::NodeHandle& nh, const std::vector<int>& scales, bool reflection,
                bool ndt);
 
@@ -70,7 +82,7 @@ class MapPublisher {
   /// when w > 0, else the whole map, cut to the box of the observed cells (an empty layer when
   /// none is). Caller's lock.
   Layers read(const wavog::WaveletMap& map, const RosParams& params, double cx, double cy);
-  /// Publishes what read() returned. No lock needed.
+  /// Publishes what read() returned; with `map`, its info on map_metadata. No lock needed.
   static void publish(const Layers& layers, const std::string& frame, const ros::Time& stamp);
 
   bool updateWanted() const { return update_pub_.getNumSubscribers() > 0; }
@@ -83,7 +95,7 @@ class MapPublisher {
 
  private:
   ros::NodeHandle nh_;
-  ros::Publisher map_pub_, update_pub_;
+  ros::Publisher map_pub_, metadata_pub_, update_pub_;
   std::map<int, ros::Publisher> scale_pubs_;
   bool reflection_ = false;
   ros::Publisher reflection_pub_;

@@ -2,13 +2,14 @@
 // role: mapping_ros.cpp (construction: inputs, tf, publishers, services, reconfigure, timers),
 // mapping_ros_scans.cpp (one scan, from the callback to the core call), mapping_ros_publish.cpp
 // (timers: layers, map_updates, ~status), mapping_ros_diagnostics.cpp (/diagnostics),
-// mapping_ros_services.cpp (~reset, ~clear_region, ~save_map, ~flush), mapping_ros_flush.cpp (the
-// end of the input: scans still waiting for tf, the last publication).
+// mapping_ros_services.cpp (~reset, ~clear_region, ~save_map, ~flush, dynamic_map),
+// mapping_ros_flush.cpp (the end of the input: scans still waiting for tf, the last publication).
 #ifndef WAVOG_MAPPING_SRC_ROS_MAPPING_ROS_IMPL_H_
 #define WAVOG_MAPPING_SRC_ROS_MAPPING_ROS_IMPL_H_
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
+#include <nav_msgs/GetMap.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
@@ -149,6 +150,10 @@ struct MappingRos::Impl {
 
   // ---- publication and status (mapping_ros_publish.cpp)
   void onPublishTimer(const ros::TimerEvent&);
+  /// The centre of publish_window: base_frame in map_frame from tf (latest); (0, 0) without a
+  /// window. False, with a throttled warning ending in `consequence`, when tf has no such pose.
+  /// Without the lock (tf2's buffer locks itself).
+  bool windowCentre(const char* consequence, double* cx, double* cy);
   /// Reads and publishes every layer and ~status now (timer, end of input, services).
   void publishAll();
   /// Publishes ~status alone (the end of the input when the map has not changed since).
@@ -167,6 +172,10 @@ struct MappingRos::Impl {
                      wavog_mapping::ClearRegion::Response& res);
   bool onSaveMap(wavog_mapping::SaveMap::Request& req, wavog_mapping::SaveMap::Response& res);
   bool onFlush(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
+  /// The `map` layer as a publication now would carry it; false (logged, throttled) when it
+  /// cannot: no observed cell yet, no window centre, or larger than kMaxLayerCells (counted in
+  /// layers_refused).
+  bool onDynamicMap(nav_msgs::GetMap::Response& res);
 
   ros::NodeHandle nh_, pnh_;
   Config config_;  ///< the run-time part changes only in onReconfigure(); guarded by mutex_
@@ -191,7 +200,7 @@ struct MappingRos::Impl {
   ros::Time last_now_;  ///< clock at the last scan (backwards-jump check)
   std::uint64_t clock_jumps_ = 0;
   std::uint64_t exceptions_ = 0;      ///< caught by guarded()
-  std::uint64_t layers_refused_ = 0;  ///< layers larger than kMaxLayerCells, not published
+  std::uint64_t layers_refused_ = 0;  ///< over kMaxLayerCells: not published, saved, served
   std::uint64_t tf_refused_ = 0;      ///< transforms the tf buffer could not take
   // Integration time over the current status period.
   double integrate_time_sum_ = 0.0;
@@ -209,7 +218,7 @@ struct MappingRos::Impl {
   std::unique_ptr<MapPublisher> publisher_;
 
   ros::Publisher status_pub_;
-  ros::ServiceServer reset_srv_, clear_srv_, save_srv_, flush_srv_;
+  ros::ServiceServer reset_srv_, clear_srv_, save_srv_, flush_srv_, dynamic_map_srv_;
   ros::Timer publish_timer_, update_timer_, diag_timer_;
   ros::WallTimer idle_timer_;
 

@@ -15,27 +15,30 @@ namespace wavog_ros {
 
 void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) { publishAll(); }
 
+bool MappingRos::Impl::windowCentre(const char* consequence, double* cx, double* cy) {
+  const RosParams& rp = config_.ros;
+  *cx = *cy = 0.0;
+  if (rp.publish_window <= 0.0) return true;
+  try {
+    const auto t = buffer_->lookupTransform(rp.map_frame, rp.base_frame, ros::Time(0));
+    *cx = t.transform.translation.x;
+    *cy = t.transform.translation.y;
+    return true;
+  } catch (const tf2::TransformException& e) {
+    ROS_WARN_THROTTLE(kWarnPeriod, "%s: no pose of '%s' for publish_window, %s: %s",
+                      pnh_.getNamespace().c_str(), rp.base_frame.c_str(), consequence, e.what());
+    return false;
+  }
+}
+
 void MappingRos::Impl::publishAll() {
   const auto t_start = std::chrono::steady_clock::now();
   const ros::Time now = ros::Time::now();
   const RosParams& rp = config_.ros;
 
-  // Window centre: the robot, from tf (latest), outside the lock. Without it nothing is published
-  // but ~status.
+  // Without a window centre nothing is published but ~status.
   double cx = 0.0, cy = 0.0;
-  bool window_ok = true;
-  if (rp.publish_window > 0.0) {
-    try {
-      const auto t = buffer_->lookupTransform(rp.map_frame, rp.base_frame, ros::Time(0));
-      cx = t.transform.translation.x;
-      cy = t.transform.translation.y;
-    } catch (const tf2::TransformException& e) {
-      window_ok = false;
-      ROS_WARN_THROTTLE(kWarnPeriod,
-                        "%s: no pose of '%s' for publish_window, maps not published: %s",
-                        pnh_.getNamespace().c_str(), rp.base_frame.c_str(), e.what());
-    }
-  }
+  const bool window_ok = windowCentre("maps not published", &cx, &cy);
 
   Layers layers;
   wavog_mapping::MapperStatus::Ptr status;

@@ -1,12 +1,14 @@
 // MappingRos's services: ~reset (forget the map), ~clear_region (forget a box), ~save_map (the
 // native map plus one map_server image per published scale, named and cropped as wavog_offline
-// does) and ~flush (the end of the input now: waiting scans, one more publication). Each answers
-// with success and a message; none throws.
+// does), ~flush (the end of the input now: waiting scans, one more publication) and dynamic_map
+// (nav_msgs/GetMap: the `map` layer as a publication now would carry it). Each answers with
+// success and a message, or for dynamic_map false, logged; none throws.
 #include <ros/ros.h>
 
 #include <cmath>
 #include <filesystem>
 #include <system_error>
+#include <utility>
 
 #include "mapping_ros_impl.h"
 #include "save_path.h"
@@ -44,6 +46,15 @@ void MappingRos::Impl::advertiseServices() {
         res.message = "internal error (logged)";
         guarded("flush service", nullptr, [&] { onFlush(req, res); });
         return true;
+      });
+  // Beside `map` (nh_), not private: the layer's own service, under the name gmapping,
+  // hector_mapping and slam_karto serve it, found without knowing the node's name. The node's
+  // commands above are private (~).
+  dynamic_map_srv_ = nh_.advertiseService<nav_msgs::GetMap::Request, nav_msgs::GetMap::Response>(
+      "dynamic_map", [this](nav_msgs::GetMap::Request&, nav_msgs::GetMap::Response& res) {
+        bool ok = false;
+        guarded("dynamic_map service", nullptr, [&] { ok = onDynamicMap(res); });
+        return ok;
       });
 }
 
@@ -150,6 +161,37 @@ bool MappingRos::Impl::onFlush(std_srvs::Trigger::Request&, std_srvs::Trigger::R
   publishAll();
   res.success = true;
   res.message = std::to_string(n) + " waiting scan(s) integrated with the latest tf; published";
+  return true;
+}
+
+bool MappingRos::Impl::onDynamicMap(nav_msgs::GetMap::Response& res) {
+  const RosParams& rp = config_.ros;
+  double cx = 0.0, cy = 0.0;
+  if (!windowCentre("dynamic_map not answered", &cx, &cy)) return false;
+  const ros::Time now = ros::Time::now();
+  wavog::Raster raster;
+  std::string refused;
+  LayerSize size = LayerSize::kEmpty;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    size = readOccupancy(map_, 0, rp, cx, cy, &raster, &refused);
+    if (size == LayerSize::kTooLarge) ++layers_refused_;
+  }
+  if (size == LayerSize::kTooLarge) {
+    ROS_ERROR_THROTTLE(kWarnPeriod,
+                       "%s: dynamic_map refused: the map layer (%s) has more than %.0f cells (the "
+                       "limit of one layer); set publish_window to serve a square around '%s'",
+                       pnh_.getNamespace().c_str(), refused.c_str(), kMaxLayerCells,
+                       rp.base_frame.c_str());
+    return false;
+  }
+  if (raster.box.empty()) {  // as gmapping before its first map: nothing to serve yet
+    ROS_WARN_THROTTLE(kWarnPeriod, "%s: dynamic_map not answered: no observed cell%s yet",
+                      pnh_.getNamespace().c_str(),
+                      rp.publish_window > 0.0 ? " in publish_window" : "");
+    return false;
+  }
+  res.map = std::move(*toOccupancyGridMsg(raster, rp.map_frame, now));
   return true;
 }
 

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <limits>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -154,6 +155,19 @@ inline void aheadOf(const Sensor& s, double d, double* x, double* y) {
 constexpr double kOccX = 3.95, kOccY = 0.05;     // on the wall x = +3.95
 constexpr double kFreeX = 0.05, kFreeY = -1.05;  // inside the room
 constexpr double kUnkX = -6.0, kUnkY = -6.0;     // outside the room
+
+/// A grid's geometry as text (size, resolution, origin; not map_load_time): compared with
+/// EXPECT_EQ, a failure shows both grids.
+inline std::string geometry(const nav_msgs::MapMetaData& info) {
+  const auto& p = info.origin.position;
+  const auto& q = info.origin.orientation;
+  std::ostringstream s;
+  s.precision(17);
+  s << info.width << " x " << info.height << " cells of " << info.resolution << " m, origin ("
+    << p.x << ", " << p.y << ", " << p.z << "), orientation (" << q.x << ", " << q.y << ", " << q.z
+    << ", " << q.w << ")";
+  return s.str();
+}
 
 /// Subscribes to `topic` and keeps its latest message in *latest, written under *mutex.
 template <typename M>

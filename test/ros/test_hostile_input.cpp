@@ -3,14 +3,16 @@
 // 1e30 and NaN, a stamp of {2^32 - 1 s, 999999999 ns}, a stamp far in the future (the next good
 // scan is 2^31 s back), a /tf transform stamped 2^32 - 1 s (the tf buffer's pruning would throw:
 // refused, counted in tf_refused), lasers placed by tf 2e5 m apart (a read-out of 1.6e13 cells: the
-// layers are refused, not allocated), save_map outside map_dir ('..', absolute, through a symlink),
-// and a map_file that is /dev/zero, a FIFO or a directory (start-up fails at once, naming it);
-// beyond the core's limits: beams of 1e7 m and FLT_MAX with range_max inf, a laser 5e10 m away, a
-// scan of 1e6 beams, clear_region of +-1e19 m. No exception may have been needed to survive:
-// ~status.exceptions stays 0.
+// layers are refused, not allocated, and dynamic_map fails, saying why), save_map outside map_dir
+// ('..', absolute, through a symlink), and a map_file that is /dev/zero, a FIFO or a directory
+// (start-up fails at once, naming it); beyond the core's limits: beams of 1e7 m and FLT_MAX with
+// range_max inf, a laser 5e10 m away, a scan of 1e6 beams, clear_region of +-1e19 m. No exception
+// may have been needed to survive: ~status.exceptions stays 0.
 #include <gtest/gtest.h>
+#include <nav_msgs/GetMap.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 #include <std_srvs/Empty.h>
 #include <sys/stat.h>
 #include <tf2_msgs/TFMessage.h>
@@ -24,6 +26,7 @@
 #include <limits>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "room.h"
 #include "run_command.h"
@@ -42,6 +45,14 @@ nav_msgs::OccupancyGrid::ConstPtr g_map;
 MapperStatus::ConstPtr g_status;
 ros::Publisher g_scan_pub;
 ros::Publisher g_tf_pub;  ///< /tf, for a hostile transform
+/// The /rosout lines that name dynamic_map.
+std::vector<std::string> g_dynamic_map_logs;
+
+void onLog(const rosgraph_msgs::Log::ConstPtr& l) {
+  if (l->msg.find("dynamic_map") == std::string::npos) return;
+  std::lock_guard<std::mutex> lock(g_mutex);
+  g_dynamic_map_logs.push_back(l->msg);
+}
 
 /// base_link -> far_plus / far_minus: lasers 2e5 m either side of the robot.
 constexpr double kFar = 2e5;
@@ -170,6 +181,23 @@ TEST_F(Hostile, HugeReadOutRefusedNotAllocated) {
   EXPECT_GE(s->inputs[0].integrated, integrated + 2);
   EXPECT_GT(s->layers_refused, 0u) << "a map 4e5 m wide must not be published whole";
   EXPECT_EQ(s->exceptions, 0u);
+
+  // dynamic_map: a failed call, not an allocation or an abort, and an error naming the limit.
+  nav_msgs::GetMap get_map;
+  EXPECT_FALSE(ros::service::call("dynamic_map", get_map)) << "a map 4e5 m wide was served";
+  std::string refusal;
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(5.0);
+  while (refusal.empty() && ros::WallTime::now() < end) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      for (const auto& line : g_dynamic_map_logs) {
+        if (line.find("dynamic_map refused") != std::string::npos) refusal = line;
+      }
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  EXPECT_NE(refusal.find("more than 16777216 cells"), std::string::npos) << refusal;
+  EXPECT_NE(refusal.find("publish_window"), std::string::npos) << refusal;
 
   // save_map: the native map is written, the images are refused (too large).
   wavog_mapping::SaveMap save;
@@ -353,7 +381,9 @@ TEST(HostileStartUp, MapFileWithPayloadsTheNodeDropsIsWarnedAbout) {
   std::string output;
   // The node keeps running after start-up: `timeout` ends it (exit 124) once it has said so.
   const int code = room::run(std::string("timeout 6 ") + WAVOG_NODE_BIN + " __name:=payloads_" +
-                                 pid + " map:=/payloads_" + pid + "/map _map_file:=" + file,
+                                 pid + " map:=/payloads_" + pid + "/map map_metadata:=/payloads_" +
+                                 pid + "/map_metadata dynamic_map:=/payloads_" + pid +
+                                 "/dynamic_map _map_file:=" + file,
                              &output);
   EXPECT_EQ(code, 124) << output;
   EXPECT_NE(output.find("holds a reflection map, which this mapper drops (reflection: false)"),
@@ -387,6 +417,7 @@ int main(int argc, char** argv) {
   auto map_sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map", 2, &g_mutex, &g_map);
   auto status_sub =
       room::keepLatest<MapperStatus>(nh, "wavog_mapping/status", 10, &g_mutex, &g_status);
+  auto log_sub = nh.subscribe("/rosout", 100, onLog);
   ros::AsyncSpinner spinner(2);
   spinner.start();
   room::waitForSubscribers(g_scan_pub, 1, 20.0);

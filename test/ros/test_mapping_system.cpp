@@ -1,10 +1,12 @@
 // Integration test, run against the node (mapping_node.test) and the nodelet
 // (mapping_nodelet.test): static tf, four synthetic scanners in a known room; asserts every
-// published layer's frame, resolution, size, origin, a known occupied, free and unknown cell, and
-// the status counters.
+// published layer's frame, resolution, size, origin, a known occupied, free and unknown cell, the
+// status counters, and map_metadata and dynamic_map beside `map`.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <map_msgs/OccupancyGridUpdate.h>
+#include <nav_msgs/GetMap.h>
+#include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -71,6 +73,8 @@ class Recorder {
 };
 
 Recorder* g_recorder = nullptr;
+std::mutex g_metadata_mutex;
+nav_msgs::MapMetaData::ConstPtr g_metadata;
 
 /// True once the layer shows the room: with forgetting (gamma 0.3) a free cell needs a few scans
 /// to fall below 35.
@@ -126,6 +130,34 @@ TEST(MappingSystem, FinestLayer) { checkLayer("map", 0); }
 TEST(MappingSystem, Scale2) { checkLayer("map_scale_2", 2); }
 TEST(MappingSystem, Scale3) { checkLayer("map_scale_3", 3); }
 TEST(MappingSystem, Scale4) { checkLayer("map_scale_4", 4); }
+
+// The cells' equality with `map` is tested where the map stands still (test/services.test,
+// test/fleet_map_services.test); here the scans go on, the geometry stays.
+TEST(MappingSystem, MapMetadataAndDynamicMapBesideMap) {
+  ASSERT_TRUE(layerReady(waitForLayer("map", 30.0)));
+  nav_msgs::OccupancyGrid::ConstPtr g;
+  nav_msgs::MapMetaData::ConstPtr meta;
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(10.0);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    g = g_recorder->grid("map");
+    {
+      std::lock_guard<std::mutex> lock(g_metadata_mutex);
+      meta = g_metadata;
+    }
+    if (meta && meta->map_load_time == g->info.map_load_time) break;
+    ros::WallDuration(0.01).sleep();
+  }
+  ASSERT_TRUE(meta) << "nothing on map_metadata";
+  EXPECT_EQ(meta->map_load_time, g->info.map_load_time) << "map_metadata not sent with map";
+  EXPECT_EQ(room::geometry(*meta), room::geometry(g->info));
+
+  nav_msgs::GetMap srv;
+  ASSERT_TRUE(ros::service::call("dynamic_map", srv));
+  const nav_msgs::OccupancyGrid& served = srv.response.map;
+  EXPECT_EQ(served.header.frame_id, "map");
+  EXPECT_EQ(room::geometry(served.info), room::geometry(g->info));
+  EXPECT_GT(room::cellAt(served, room::kOccX, room::kOccY), 65);
+}
 
 TEST(MappingSystem, StatusCounters) {
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(30.0);
@@ -246,6 +278,8 @@ int main(int argc, char** argv) {
               g_recorder->onGrid(topic, g);
             })));
   }
+  subs.push_back(room::keepLatest<nav_msgs::MapMetaData>(nh, "map_metadata", 2, &g_metadata_mutex,
+                                                         &g_metadata));
   subs.push_back(nh.subscribe("wavog_mapping/status", 10, &Recorder::onStatus, &recorder));
   subs.push_back(nh.subscribe("map_updates", 10, &Recorder::onUpdate, &recorder));
   subs.push_back(nh.subscribe("/diagnostics", 10, &Recorder::onDiagnostics, &recorder));

@@ -1,9 +1,12 @@
-// Services: ~clear_region clears only its box, ~reset empties the map, ~save_map writes the native
-// file and map_server images, and a node restarted with map_file publishes the same map. A
-// corrupted map_file and a bad parameter stop the node at start-up (exit 1) with a clear message.
+// Services: map_metadata carries `map`'s info and dynamic_map answers `map` itself, ~clear_region
+// clears only its box, ~reset empties the map, ~save_map writes the native file and map_server
+// images, and a node restarted with map_file publishes the same map. A corrupted map_file and a
+// bad parameter stop the node at start-up (exit 1) with a clear message.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
+#include <nav_msgs/GetMap.h>
+#include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
@@ -26,6 +29,7 @@ namespace {
 std::mutex g_mutex;
 nav_msgs::OccupancyGrid::ConstPtr g_map;
 nav_msgs::OccupancyGrid::ConstPtr g_restored;
+nav_msgs::MapMetaData::ConstPtr g_metadata;
 ros::Publisher g_scan_pub;
 
 nav_msgs::OccupancyGrid::ConstPtr get(const nav_msgs::OccupancyGrid::ConstPtr& which) {
@@ -71,6 +75,39 @@ class Services : public ::testing::Test {
     ros::WallDuration(0.3).sleep();
   }
 };
+
+// First: the map of the set-up's scans, unchanged since (no scan after it).
+TEST_F(Services, MapMetadataAndDynamicMapCarryTheMap) {
+  const auto map = nextMap();
+  ASSERT_TRUE(map);
+  ASSERT_GT(room::cellAt(*map, room::kOccX, room::kOccY), 65);
+  // map_metadata goes out with every `map`: the latest of each soon carry the same info,
+  // map_load_time (the publication's stamp) included.
+  nav_msgs::MapMetaData::ConstPtr meta;
+  nav_msgs::OccupancyGrid::ConstPtr with;
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(10.0);
+  while (ros::WallTime::now() < end) {
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      meta = g_metadata;
+      with = g_map;
+    }
+    if (meta && meta->map_load_time == with->info.map_load_time) break;
+    ros::WallDuration(0.01).sleep();
+  }
+  ASSERT_TRUE(meta) << "nothing on map_metadata";
+  EXPECT_EQ(meta->map_load_time, with->info.map_load_time);
+  EXPECT_EQ(room::geometry(*meta), room::geometry(with->info));
+
+  // dynamic_map (beside `map`, not private): the map as `map` carries it.
+  nav_msgs::GetMap srv;
+  ASSERT_TRUE(ros::service::call("dynamic_map", srv));
+  const nav_msgs::OccupancyGrid& served = srv.response.map;
+  EXPECT_EQ(served.header.frame_id, map->header.frame_id);
+  EXPECT_GE(served.header.stamp, map->header.stamp);
+  EXPECT_EQ(room::geometry(served.info), room::geometry(map->info));
+  EXPECT_TRUE(served.data == map->data) << "dynamic_map differs from map";
+}
 
 TEST_F(Services, SaveMapWritesNativeAndMapServerFiles) {
   const auto before = nextMap();
@@ -118,9 +155,11 @@ TEST_F(Services, SaveMapWritesNativeAndMapServerFiles) {
 
   // A node restarted with map_file publishes the same map (same geometry, same values).
   std::string output;
-  const std::string cmd = std::string("timeout 20 ") + WAVOG_NODE_BIN +
-                          " __name:=restored map:=/restored/map scan_1:=/restored/scan" +
-                          " _map_file:=" + kMapFile;
+  const std::string cmd =
+      std::string("timeout 20 ") + WAVOG_NODE_BIN +
+      " __name:=restored map:=/restored/map scan_1:=/restored/scan" +
+      " map_metadata:=/restored/map_metadata dynamic_map:=/restored/dynamic_map" +
+      " _map_file:=" + kMapFile;
   ros::param::set("/restored/resolution", 0.1);
   ros::param::set("/restored/block_levels", 6);
   std::thread restored([&] { room::run(cmd, &output); });
@@ -206,7 +245,8 @@ TEST_F(Services, PublishWindowLimitsTheGrid) {
   std::string output;
   std::thread node([&] {
     room::run(std::string("timeout 20 ") + WAVOG_NODE_BIN +
-                  " __name:=window map:=/window/map scan:=/window/scan",
+                  " __name:=window map:=/window/map scan:=/window/scan"
+                  " map_metadata:=/window/map_metadata dynamic_map:=/window/dynamic_map",
               &output);
   });
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(20.0);
@@ -406,6 +446,8 @@ int main(int argc, char** argv) {
   static_tf.sendTransform(room::staticTree());
   g_scan_pub = nh.advertise<sensor_msgs::LaserScan>("scan_1", 50);
   auto map_sub = room::keepLatest<nav_msgs::OccupancyGrid>(nh, "map", 2, &g_mutex, &g_map);
+  auto meta_sub =
+      room::keepLatest<nav_msgs::MapMetaData>(nh, "map_metadata", 2, &g_mutex, &g_metadata);
   auto restored_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
       "restored/map", 2,
       boost::function<void(const nav_msgs::OccupancyGrid::ConstPtr&)>(

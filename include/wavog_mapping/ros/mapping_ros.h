@@ -1,7 +1,8 @@
 // MappingRos: the one class behind the nodelet and the node. Subscribes to 1-4 LaserScan topics
 // through tf2 MessageFilters, integrates every scan into one wavog::WaveletMap and publishes the
-// multiscale OccupancyGrid layers, map_updates, ~status and /diagnostics on timers; serves ~reset,
-// ~clear_region, ~save_map; dynamic_reconfigure for the policy, the publish rate and the scales.
+// multiscale OccupancyGrid layers, map_metadata, map_updates, ~status and /diagnostics on timers;
+// serves ~reset, ~clear_region, ~save_map, ~flush, dynamic_map; dynamic_reconfigure for the
+// policy, the publish rate and the scales.
 // Thread-safety: callbacks may run on several threads (MT node handles); ONE mutex (mutex_) guards
 // the map, the counters and everything else they share; tf2's buffer locks itself.
 #ifndef WAVOG_MAPPING_ROS_MAPPING_ROS_H_
