@@ -7,7 +7,8 @@
 // message is refused by one reason, overflows, is late or is integrated / refused by the core) and
 // `lost`, index_regressions and index_jumps equal an independent 128-bit count of the index
 // sequence; a message that passed the checks is one the core takes without refusing its
-// geometry, at a stamp ros::Time arithmetic can handle; the map stays finite at every scale.
+// geometry, at a stamp ros::Time arithmetic can handle, and one refused as bad size is one the
+// core refuses as bad geometry (or empty); the map stays finite at every scale.
 #include <ros/time.h>
 
 #include <cmath>
@@ -211,6 +212,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const wavog_fleet::Intake got = wavog_fleet::takeIn(*m, limits, now, &v.index, &v.c);
       WAVOG_FUZZ_CHECK(got.refusal == wavog_fleet::Refusal::kNone || !got.detail.empty(),
                        "refusal %s without a detail", wavog_fleet::toString(got.refusal));
+      if (got.refusal == wavog_fleet::Refusal::kBadSize) {
+        // The converse: what the checks call bad size, the core refuses as such (a mapper's
+        // message is never refused for a scan its core integrated).
+        wavog::WaveletMap scratch(params);
+        const wavog::ScanStatus st =
+            scratch.integrate(wavog_fleet::placedPose(*m), wavog_fleet::placedView(*m)).status;
+        WAVOG_FUZZ_CHECK(st == wavog::ScanStatus::kBadGeometry || st == wavog::ScanStatus::kEmpty,
+                         "bad_size to the fleet, %s to the core: %s", wavog::toString(st),
+                         got.detail.c_str());
+      }
       if (got.refusal == wavog_fleet::Refusal::kNone) {
         // What FleetReceiver computes on a message that passed: fits ros::Time arithmetic.
         const double offset = wavog_ros::secondsBetween(m->header.stamp, now);
