@@ -7,8 +7,9 @@
 // message is refused by one reason, overflows, is late or is integrated / refused by the core) and
 // `lost`, index_regressions and index_jumps equal an independent 128-bit count of the index
 // sequence; a message that passed the checks is one the core takes without refusing its
-// geometry, at a stamp ros::Time arithmetic can handle, and one refused as bad size is one the
-// core refuses as bad geometry (or empty); the map stays finite at every scale.
+// geometry, at a stamp ros::Time arithmetic can handle, with a period a mapper sends ([0,
+// ScanPeriod::kMaxPeriod]), and one refused as bad size has an absurd period or is one the core
+// refuses as bad geometry (or empty); the map stays finite at every scale.
 #include <ros/time.h>
 
 #include <cmath>
@@ -24,6 +25,7 @@
 #include "fuzz_support.h"
 #include "wavog_mapping/PlacedScan.h"
 #include "wavog_mapping/VehicleStatus.h"
+#include "wavog_mapping/core/scan_period.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/ros/conversions.h"
 
@@ -212,9 +214,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const wavog_fleet::Intake got = wavog_fleet::takeIn(*m, limits, now, &v.index, &v.c);
       WAVOG_FUZZ_CHECK(got.refusal == wavog_fleet::Refusal::kNone || !got.detail.empty(),
                        "refusal %s without a detail", wavog_fleet::toString(got.refusal));
-      if (got.refusal == wavog_fleet::Refusal::kBadSize) {
+      const bool period_ok =
+          m->period >= 0.0 && m->period <= wavog::ScanPeriod::kMaxPeriod;  // a mapper's
+      if (got.refusal == wavog_fleet::Refusal::kBadSize && period_ok) {
         // The converse: what the checks call bad size, the core refuses as such (a mapper's
-        // message is never refused for a scan its core integrated).
+        // message is never refused for a scan its core integrated); or its period is absurd.
         wavog::WaveletMap scratch(params);
         const wavog::ScanStatus st =
             scratch.integrate(wavog_fleet::placedPose(*m), wavog_fleet::placedView(*m)).status;
@@ -230,6 +234,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                          "stamp %u.%u passed, %g s from the clock", m->header.stamp.sec,
                          m->header.stamp.nsec, offset);
         (void)(m->header.stamp - now);  // may throw beyond 2^31 s: not after the check
+        WAVOG_FUZZ_CHECK(period_ok, "period %g passed", m->period);
         v.c.last_stamp = m->header.stamp;
         const wavog_fleet::OrderKey key{static_cast<std::int64_t>(m->header.stamp.toNSec()),
                                         static_cast<int>(vi), m->index};

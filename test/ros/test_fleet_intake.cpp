@@ -46,7 +46,7 @@ struct Stream {
 TEST(FleetIntake, RefusedMessagesAreDeliveredNotLost) {
   Stream s;
   EXPECT_EQ(s.take(goodScan(0)).refusal, Refusal::kNone);
-  // Indices 1..5, each refused by another check: all delivered.
+  // Indices 1..6, each refused by a check: all delivered.
   auto m = goodScan(1);
   m.version = 7;
   EXPECT_EQ(s.take(m).refusal, Refusal::kVersion);
@@ -62,15 +62,19 @@ TEST(FleetIntake, RefusedMessagesAreDeliveredNotLost) {
   m = goodScan(5);
   m.angle_increment = 1e-310;
   EXPECT_EQ(s.take(m).refusal, Refusal::kBadSize);
-  const wavog_fleet::Intake last = s.take(goodScan(6));
+  m = goodScan(6);
+  m.period = 1e300;  // under forget_half_life: every cell of its fan forgotten at once
+  EXPECT_EQ(s.take(m).refusal, Refusal::kBadSize);
+  const wavog_fleet::Intake last = s.take(goodScan(7));
   EXPECT_EQ(last.refusal, Refusal::kNone);
   EXPECT_EQ(last.step, IndexStep::kNext);
-  EXPECT_EQ(s.c.received, 7u);
-  EXPECT_GT(s.c.bytes, 7u * 181u * 4u);
+  EXPECT_EQ(s.c.received, 8u);
+  EXPECT_GT(s.c.bytes, 8u * 181u * 4u);
   EXPECT_EQ(s.c.lost, 0u);
+  EXPECT_EQ(s.c.dropped_bad_size, 2u);
   EXPECT_EQ(s.c.dropped_version + s.c.dropped_frame + s.c.dropped_bad_stamp +
                 s.c.dropped_bad_pose + s.c.dropped_bad_size,
-            5u);
+            6u);
   EXPECT_EQ(s.c.index_regressions + s.c.index_jumps, 0u);
 }
 
