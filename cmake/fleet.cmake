@@ -8,6 +8,7 @@ endif()
 target_sources(wavog_ros PRIVATE
   src/ros/mapping_ros_fleet.cpp
   src/ros/fleet/placed_scan.cpp
+  src/ros/fleet/intake.cpp
   src/ros/fleet/fleet_stream.cpp
   src/ros/fleet/fleet_receiver.cpp)
 
@@ -30,6 +31,12 @@ if(CATKIN_ENABLE_TESTING)
       target_include_directories(test_fleet_merge PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
       target_link_libraries(test_fleet_merge wavog_ros wavog_sim ${GTEST_MAIN_LIBRARIES})
     endif()
+  endif()
+  # A vehicle's intake (issue 37): counters, refusals, the index sequence.
+  catkin_add_gtest(test_fleet_intake test/ros/test_fleet_intake.cpp)
+  if(TARGET test_fleet_intake)
+    target_include_directories(test_fleet_intake PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
+    target_link_libraries(test_fleet_intake wavog_ros ${GTEST_MAIN_LIBRARIES})
   endif()
 endif()
 

@@ -41,6 +41,39 @@ if(WAVOG_FUZZ)
       ${WAVOG_FUZZ_ROSTIME} ${WAVOG_FUZZ_CONSOLE_BRIDGE})
     wavog_fuzzer(fuzz_node)
     target_link_libraries(fuzz_node PRIVATE wavog_fuzz_node_glue)
+
+    # 5: the fleet node's message path (intake, checks, reorder buffer, core call): its message
+    # headers generated here with Debian's gencpp (this tree has no catkin), its sources compiled
+    # against them.
+    find_program(WAVOG_FUZZ_PYTHON3 python3 PATHS /usr/bin NO_DEFAULT_PATH)
+    if(WAVOG_FUZZ_PYTHON3 AND EXISTS /usr/lib/gencpp/gen_cpp.py
+       AND EXISTS /usr/share/std_msgs/msg/Header.msg)
+      set(_msgs ${CMAKE_BINARY_DIR}/fuzz_msgs)
+      set(_headers)
+      foreach(_m PlacedScan VehicleStatus)
+        list(APPEND _headers ${_msgs}/wavog_mapping/${_m}.h)
+        add_custom_command(OUTPUT ${_msgs}/wavog_mapping/${_m}.h
+          COMMAND ${WAVOG_FUZZ_PYTHON3} /usr/lib/gencpp/gen_cpp.py
+            ${CMAKE_CURRENT_SOURCE_DIR}/msg/${_m}.msg
+            -Iwavog_mapping:${CMAKE_CURRENT_SOURCE_DIR}/msg -Istd_msgs:/usr/share/std_msgs/msg
+            -p wavog_mapping -o ${_msgs}/wavog_mapping -e /usr/share/gencpp
+          DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/msg/${_m}.msg
+          COMMENT "gencpp: ${_m}.h for fuzz_fleet")
+      endforeach()
+      add_custom_target(wavog_fuzz_msgs DEPENDS ${_headers})
+      add_library(wavog_fuzz_fleet_glue STATIC src/ros/fleet/placed_scan.cpp
+        src/ros/fleet/intake.cpp)
+      add_dependencies(wavog_fuzz_fleet_glue wavog_fuzz_msgs)
+      # catkin_lint: the generated headers live in the fuzz tree (made at build time) by design.
+      #catkin_lint: ignore_once MISSING_DIRECTORY EXTERNAL_DIRECTORY EXTERNAL_INTERFACE_PATH
+      target_include_directories(wavog_fuzz_fleet_glue SYSTEM PUBLIC ${_msgs})
+      target_include_directories(wavog_fuzz_fleet_glue PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
+      target_link_libraries(wavog_fuzz_fleet_glue PUBLIC wavog_fuzz_node_glue)
+      wavog_fuzzer(fuzz_fleet)
+      target_link_libraries(fuzz_fleet PRIVATE wavog_fuzz_fleet_glue)
+    else()
+      message(WARNING "fuzz_fleet not built: /usr/lib/gencpp/gen_cpp.py or std_msgs missing")
+    endif()
   else()
     message(WARNING "fuzz_node not built: Debian's ROS headers or libtf2/librostime missing")
   endif()

@@ -158,7 +158,8 @@ wavog::CellClass ReferenceClassifier::cellClass(std::int64_t ix, std::int64_t iy
   return wavog::CellClass::kUnknown;
 }
 
-void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& scan) {
+void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& scan,
+                               std::size_t repeat) {
   last_updated_ = 0;
   ReferenceClassifier ref;
   if (!ref.prepare(p_, pose, scan)) return;
@@ -178,23 +179,28 @@ void DenseReference::integrate(const wavog::Pose2& pose, const wavog::ScanView& 
       if (cls == wavog::CellClass::kUnknown) continue;
       const bool occupied = cls == wavog::CellClass::kOccupied;
       const std::size_t i = index(ix, iy);
-      for (std::size_t k = 0; k < layers_.size(); ++k)
-        v_[k][i] = apply(layers_[k], occupied, v_[k][i]);
-      if (v_.size() >= 2 && v_[0][i] + v_[1][i] > sum_bound_) {
-        const double f = sum_bound_ / (v_[0][i] + v_[1][i]);
-        v_[0][i] *= f;
-        v_[1][i] *= f;
-      }
-      if (occupancy_layer_ < v_.size() && v_[0][i] > 0.0 &&
-          v_[occupancy_layer_][i] <= empty_bound_ + 1e-5) {
-        v_[0][i] = 0.0;
-        v_[1][i] = sum_bound_;
+      for (std::size_t r = 0; r < repeat; ++r) {
+        for (std::size_t k = 0; k < layers_.size(); ++k)
+          v_[k][i] = apply(layers_[k], occupied, v_[k][i]);
+        if (v_.size() >= 2 && v_[0][i] + v_[1][i] > sum_bound_) {
+          const double f = sum_bound_ / (v_[0][i] + v_[1][i]);
+          v_[0][i] *= f;
+          v_[1][i] *= f;
+        }
+        if (occupancy_layer_ < v_.size() && v_[0][i] > 0.0 &&
+            v_[occupancy_layer_][i] <= empty_bound_ + 1e-5) {
+          v_[0][i] = 0.0;
+          v_[1][i] = sum_bound_;
+        }
       }
       known_[i] = 1;
       ++last_updated_;
     }
   }
-  if (p_.ndt) integrateNdt(ref, pose, scan);
+  if (p_.ndt) {
+    if (repeat != 1) throw std::invalid_argument("DenseReference: NDT cells integrate once");
+    integrateNdt(ref, pose, scan);
+  }
 }
 
 // Normal-distribution cells (MapParams::ndt) of layer 0: every observed cell's moments forget by

@@ -50,7 +50,8 @@ class DenseReference {
   /// must share grid and sensor geometry: resolution, band_width, max_range, no_return_clear).
   DenseReference(const std::vector<wavog::MapParams>& layers, const wavog::CellBox& extent);
 
-  void integrate(const wavog::Pose2& pose, const wavog::ScanView& scan);
+  /// Integrates the scan `repeat` times (classified once; NDT cells: repeat must be 1).
+  void integrate(const wavog::Pose2& pose, const wavog::ScanView& scan, std::size_t repeat = 1);
   /// Sets the forgetting rate of layer `layer` for the following scans (a per-scan gamma, as
   /// forget_half_life makes them).
   void setGamma(std::size_t layer, double gamma) { layers_.at(layer).policy.gamma = gamma; }

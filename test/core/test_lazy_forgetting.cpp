@@ -70,7 +70,7 @@ TEST(LazyForgetting, EmptyScansTagNodesAndLeaveStoredDetailsUntouched) {
   WaveletMap map(forgetParams(true));
   for (int i = 0; i < 5; ++i)
     map.integrate({0.1 * i, 0.05 * i, 0.1 * i}, roomScan({0.1 * i, 0.05 * i, 0.1 * i}, 2.0).view());
-  std::map<const void*, std::tuple<float, float, float, int>> before;
+  std::map<const void*, std::tuple<double, double, double, int>> before;
   wavog::MapAccess::forEachNode(map, [&](const wavog::detail::Node& n, int, int pending) {
     before[&n] = {n.d[0], n.d[1], n.d[2], pending};
   });

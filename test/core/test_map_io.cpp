@@ -334,7 +334,7 @@ TEST(MapIo, LogOddsTheUpdateCannotCarryAreRefused) {
       EXPECT_EQ(everyValueFinite(target), 0u);
     }
   }
-  const float detail = 3e38f;  // finite, but the update's new details overflow float
+  const double detail = 1.01e30;  // finite, beyond the bound
   writeAll(path, patched(kDetailAt, &detail, sizeof(detail)));
   WaveletMap target(params());
   EXPECT_NE(refusal(&target, path).find("beyond"), std::string::npos);
@@ -391,7 +391,7 @@ TEST(MapIo, InspectFileSaysWhichPayloadsAFileHolds) {
 
 
 // Hand-built files: the header and the payload sections of an empty map saved under `p`, with
-// the blocks `blocks` (the version-5 encoding, block count `count`) in place of none.
+// the blocks `blocks` (the version-6 encoding, block count `count`) in place of none.
 std::vector<char> fileWithBlocks(const MapParams& p, std::uint64_t count,
                                  const std::vector<char>& blocks) {
   const std::string path = tempPath("empty.wavog");
@@ -420,8 +420,8 @@ struct BlockBytes {
   BlockBytes& block(std::int32_t bx, std::int32_t by, double s, std::uint8_t flags) {
     return put(bx).put(by).put(s).put(flags);
   }
-  // A node: details, no pending count, child mask and knowledge bits.
-  BlockBytes& node(float dx, float dy, float dxy, std::uint8_t mask, std::uint8_t all,
+  // A node: details (f64 since version 6), no pending count, child mask and knowledge bits.
+  BlockBytes& node(double dx, double dy, double dxy, std::uint8_t mask, std::uint8_t all,
                    std::uint8_t any) {
     return put(dx).put(dy).put(dxy).put(std::uint16_t{0}).put(mask).put(all).put(any);
   }
@@ -529,8 +529,8 @@ TEST(MapIo, ReflectionPointQueryAgreesWithReadOutAtLargeLogOdds) {
   auto bytes = readAll(path);
   constexpr std::size_t kFlagsAt = 8 + 4 + 8 + 4 + 8 + 8 + 8 + 4 + 4 + 8;  // block 0's flags
   ASSERT_TRUE(bytes[kFlagsAt] & 4) << "block 0 has no root node";
-  const float detail = 5.44e15f;  // block 0's root dy
-  std::memcpy(bytes.data() + kFlagsAt + 1 + 4, &detail, sizeof(detail));
+  const double detail = 5.44e15;  // block 0's root dy (f64 since version 6)
+  std::memcpy(bytes.data() + kFlagsAt + 1 + 8, &detail, sizeof(detail));
   bytes.resize(bytes.size() - 4);
   appendCrc(&bytes);
   writeAll(path, bytes);

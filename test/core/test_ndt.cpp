@@ -439,7 +439,9 @@ TEST(Ndt, FilesOfFormatVersion2StillLoad) {
   std::size_t observed = 0;
   for (std::int64_t y = -40; y < 40; ++y) {
     for (std::int64_t x = -40; x < 40; ++x) {
-      ASSERT_EQ(loaded.value({x, y}), made.value({x, y}));
+      // Up to the float round-off of the file's details (f32 before version 6).
+      ASSERT_NEAR(loaded.value({x, y}), made.value({x, y}),
+                  1e-6 * std::max(1.0f, std::fabs(made.value({x, y}))));
       ASSERT_EQ(loaded.isObserved({x, y}), made.isObserved({x, y}));
       // The file's hits and misses layers against today's hits with misses from the occupancy.
       const float a = loaded.reflection({x, y}), b = made.reflection({x, y});

@@ -504,7 +504,8 @@ TEST(Reflection, ClampFilesOfFormatVersion4Restart) {
   WaveletMap made(p);
   RandomScans again(20261202u, 6.0);
   integrateScans(&again, 30, made);
-  expectSameCells(made, loaded, 30, 0.0);
+  // Up to the float round-off of the file's details (f32 before version 6).
+  expectSameCells(made, loaded, 30, 1e-6);
   for (float v : loaded.exportReflection(0, extent).p) ASSERT_TRUE(std::isnan(v));
   run.ref.setInitial(0, 0.0);
   run.ref.setInitial(1, 0.0);

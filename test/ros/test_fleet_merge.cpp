@@ -16,6 +16,7 @@
 
 #include "fleet/placed_scan.h"
 #include "fleet/reorder_buffer.h"
+#include "wavog_mapping/core/scan_period.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/sim/laser_sim.h"
 #include "wavog_mapping/sim/world.h"
@@ -186,6 +187,31 @@ TEST(PlacedScanCheck, RefusesForeignInputByName) {
   m.range_max = 0.05;  // below range_min
   EXPECT_EQ(check(m), Refusal::kBadSize);
   EXPECT_STREQ(wavog_fleet::toString(Refusal::kVersion), "version");
+}
+
+// A mapper's period comes from wavog::ScanPeriod: 0 (unknown) or in (0, kMaxPeriod]. Any other
+// one is foreign: under forget_half_life a period of 1e300 would forget, in one scan, every cell
+// its fan observes.
+TEST(PlacedScanCheck, RefusesAPeriodNoMapperSendsAsBadSize) {
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double good : {0.0, -0.0, 1e-9, 0.025, wavog::ScanPeriod::kMaxPeriod}) {
+    auto m = goodScan();
+    m.period = good;
+    EXPECT_EQ(check(m), Refusal::kNone) << "period " << good;
+  }
+  for (const double bad : {std::numeric_limits<double>::quiet_NaN(), inf, -inf, -0.025,
+                           -std::numeric_limits<double>::denorm_min(),
+                           std::nextafter(wavog::ScanPeriod::kMaxPeriod, inf), 1e300}) {
+    auto m = goodScan();
+    m.period = bad;
+    EXPECT_EQ(check(m), Refusal::kBadSize) << "period " << bad;
+  }
+  wavog::MapParams params = wavog::MapParams::defaultsFor(wavog::PolicyType::kForget);
+  params.policy.forget_half_life = 10.0;
+  const wavog::WaveletMap map(params);
+  // What the check keeps from the fleet map: the core's full forgetting (every value negligible).
+  EXPECT_GT(map.forgetRate(1e300), 1.0 - 1e-6);
+  EXPECT_LT(map.forgetRate(wavog::ScanPeriod::kMaxPeriod), 0.07) << "a mapper's longest";
 }
 
 // ---- the merge rule ------------------------------------------------------------------------------

@@ -59,9 +59,10 @@ constexpr std::size_t kScratchKeepBeams = std::size_t{1} << 16;
 
 /// Largest |log-odds| of a block average or a stored detail in a map file (1e30); a file holding a
 /// larger one is refused (MapIoError). Below it a cell's value (the average plus at most three
-/// details per level, 12 levels) stays under 4e31, so the details an update writes back (floats,
-/// at most the largest |value| of the cells they combine) stay 1e7 times under FLT_MAX: every
-/// update keeps the map finite. The updates themselves stay far below it (|odd| <= 50 per scan).
+/// details per level, 12 levels) stays under 4e31, so the details an update writes back (doubles
+/// since issue 37, floats in files before version 6; at most the largest |value| of the cells they
+/// combine) stay far under FLT_MAX: every update keeps the map finite, and a map holds nothing an
+/// older build could not. The updates themselves stay far below it (|odd| <= 50 per scan).
 constexpr double kMaxStoredLogOdds = 1e30;
 
 /// Largest read-out, in raster cells (2^26: e.g. 8192 x 8192, 320 MiB of raster); exportScale

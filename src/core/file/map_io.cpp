@@ -1,8 +1,8 @@
-// Native map files. Layout (little-endian, version 5):
+// Native map files. Layout (little-endian, version 6):
 //   "WAVOGMAP" | u32 version | f64 resolution | i32 block_levels | f64 prior | f64 a (the factor
 //   one pending unit stands for: 1 - gamma, or 2^-unit with forget_half_life) | u64 block count
 //   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
-//              [root subtree, pre-order: f32 dx dy dxy (stored) | u16 pending count k |
+//              [root subtree, pre-order: f64 dx dy dxy (stored) | u16 pending count k |
 //               u8 child_mask | u8 known_all | u8 known_any | children in q order]
 //   u8 reflection layers, a mask (1: hits, 2: misses; before version 4 their count, hits first),
 //   each: f64 a | u64 block count | blocks as above
@@ -14,7 +14,8 @@
 //   each: i32 bx | i32 by | u8 kind (0 counts, 1 ratios, 2 pairs) | u32 n | n cells ascending by
 //   code: u32 code | u32 count, f32 ratio, or f32 hits f32 misses (reflection_store.h)
 //   u32 CRC-32 (IEEE) of every byte before it.
-// Version 4 is the same without pairs (the clamps counted without bound; such a reflection map
+// Version 5 is the same with f32 details (before issue 37: the nodes held floats). Version 4 is
+// the same without pairs (the clamps counted without bound; such a reflection map
 // restarts on loading). Version 3 (before the hits) is the same without the reflection section (its
 // layers hold the hits and misses: kLayers), version 2 (before ndt) also without the NDT section,
 // version 1 (before forget_half_life and reflection) also with a u8 pending count and no layers;
@@ -48,14 +49,16 @@ using detail::Reader;
 using detail::Writer;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
-constexpr std::uint32_t kVersion = 5;
+constexpr std::uint32_t kVersion = 6;
 constexpr std::uint32_t kOldestVersion = 1;  // u8 pending counts
 // Fixed header: magic, version, resolution, block_levels, prior, forgetting factor, block count.
 constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
 constexpr std::size_t kCrcBytes = 4;
 constexpr std::size_t kMinBlockBytes = 4 + 4 + 8 + 1;  // bx, by, average, flags
-// Three details, k, mask, known bits.
-std::size_t nodeBytes(std::uint32_t version) { return 3 * 4 + (version == 1 ? 1 : 2) + 3; }
+// Three details (f64 from version 6, f32 before), k, mask, known bits.
+std::size_t nodeBytes(std::uint32_t version) {
+  return 3 * (version >= 6 ? 8 : 4) + (version == 1 ? 1 : 2) + 3;
+}
 
 std::uint32_t crc32(const unsigned char* data, std::size_t size) {
   static const std::array<std::uint32_t, 256> table = [] {
@@ -73,7 +76,7 @@ std::uint32_t crc32(const unsigned char* data, std::size_t size) {
 }
 
 void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
-  for (float d : n.d) w->put(d);
+  for (double d : n.d) w->put(d);
   w->put(n.k);
   w->put(n.child_mask);
   w->put(static_cast<std::uint8_t>(n.known_all));
@@ -120,8 +123,8 @@ void checkUniformKnowledge(bool all, bool any) {
 // counts applied the same way.
 void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, std::int64_t pending,
               bool slot_all, bool slot_any, Reader* r) {
-  for (float& d : n.d) {
-    d = r->get<float>();
+  for (double& d : n.d) {
+    d = f.version >= 6 ? r->get<double>() : static_cast<double>(r->get<float>());
     if (!std::isfinite(d)) throw std::runtime_error("non-finite detail");
     if (std::fabs(d) > kMaxStoredLogOdds) throw std::runtime_error(beyondBound("a detail", d));
   }
@@ -130,8 +133,8 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
     n.k = static_cast<std::uint16_t>(k);
   } else {
     pending += k;
-    const auto m = static_cast<float>(std::pow(f.file_a, static_cast<double>(pending)));
-    for (float& d : n.d) d *= m;
+    const double m = std::pow(f.file_a, static_cast<double>(pending));
+    for (double& d : n.d) d *= m;
     n.k = 0;
   }
   const auto mask = r->get<std::uint8_t>();

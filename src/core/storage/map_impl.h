@@ -218,8 +218,8 @@ inline detail::Node& WaveletMap::Impl::installChild(detail::NodeStore& store, de
 
 inline void WaveletMap::Impl::flush(detail::Node& n) {
   if (n.k == 0) return;
-  const float m = static_cast<float>(multiplier(n.k));
-  for (float& d : n.d) d *= m;
+  const double m = multiplier(n.k);
+  for (double& d : n.d) d *= m;
   if (n.children != 0) {
     for (int q = 0; q < 4; ++q) {
       if (hasChild(n, q)) addPending(child(n, q), n.k);

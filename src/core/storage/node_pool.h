@@ -25,14 +25,18 @@ namespace detail {
 /// zero); `Node n;` is uninitialised, so that the pool's chunks need not be cleared (allocate()
 /// clears each group it hands out).
 struct Node {
-  float d[3];                  ///< stored details dx, dy, dxy (true = stored * multiplier(k's))
+  /// Stored details dx, dy, dxy (true = stored * multiplier(k's)). Double: a cell is its block's
+  /// average plus its ancestors' details, so beside a cell of log-odds L the float details could
+  /// only hold it to about L * 2^-24 per level, and every update rounded them again (issue 37: an
+  /// unbounded policy's 24,000 scans of one fan moved unobserved cells next to it by 1.2).
+  double d[3];
   std::uint32_t children;      ///< pool group of the 4 child slots; 0 = no child node
   std::uint16_t k;             ///< pending forgetting units for this node and its subtree
   std::uint8_t child_mask;     ///< bit q: child node q exists in the group
   std::uint8_t known_all : 4;  ///< bit q: every finest cell of child q was observed
   std::uint8_t known_any : 4;  ///< bit q: some finest cell of child q was observed
 };
-static_assert(sizeof(Node) == 20, "Node layout grew");
+static_assert(sizeof(Node) == 32, "Node layout grew");
 static_assert(std::is_trivial<Node>::value, "Node must stay trivial (uncleared pool chunks)");
 
 struct NodeGroup {
@@ -168,7 +172,7 @@ class NodePool {
   }
 
  private:
-  static constexpr std::uint32_t kChunkBits = 8;  // 256 groups (20 KiB) per chunk
+  static constexpr std::uint32_t kChunkBits = 8;  // 256 groups (32 KiB) per chunk
   static constexpr std::uint32_t kChunkMask = (1u << kChunkBits) - 1;
   using Slot = std::atomic<NodeGroup*>;
 
@@ -252,9 +256,9 @@ class NodeStore {
 };
 
 /// Largest stored detail magnitude of a node (stored, without pending tags).
-inline float maxAbsDetail(const Node& n) {
-  const float a = std::fabs(n.d[0]), b = std::fabs(n.d[1]), c = std::fabs(n.d[2]);
-  const float ab = a > b ? a : b;
+inline double maxAbsDetail(const Node& n) {
+  const double a = std::fabs(n.d[0]), b = std::fabs(n.d[1]), c = std::fabs(n.d[2]);
+  const double ab = a > b ? a : b;
   return ab > c ? ab : c;
 }
 

@@ -93,9 +93,7 @@ template <typename Slot, typename Update>
 inline double foldChanges(Node& n, const std::array<double, 4>& delta) {
   haar::Details<double> dd;
   const double ds = haar::forward(delta, &dd);
-  for (int i = 0; i < 3; ++i) {
-    n.d[i] = static_cast<float>(static_cast<double>(n.d[i]) + dd[static_cast<std::size_t>(i)]);
-  }
+  for (int i = 0; i < 3; ++i) n.d[i] += dd[static_cast<std::size_t>(i)];
   return ds;
 }
 

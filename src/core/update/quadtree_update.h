@@ -393,8 +393,7 @@ class Integrator {
   // Eager forgetting (lazy tags off): every detail of the subtree times a, now.
   void scaleSubtree(Node& n) {
     ++visited_;
-    const auto a = static_cast<float>(pc_.a);
-    for (float& d : n.d) d *= a;
+    for (double& d : n.d) d *= pc_.a;
     if (n.children == 0) return;
     for (int q = 0; q < 4; ++q) {
       if (impl_.hasChild(n, q)) scaleSubtree(impl_.child(n, q));

@@ -2,12 +2,11 @@
 // counters, ~fleet_status and the per-vehicle diagnostics.
 #include "fleet_receiver.h"
 
-#include <ros/serialization.h>
-
 #include <algorithm>
 #include <boost/make_shared.hpp>
 #include <stdexcept>
 
+#include "intake.h"
 #include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_fleet {
@@ -98,46 +97,24 @@ void FleetReceiver::onMessage(Vehicle* v,
   const ros::WallTime now = ros::WallTime::now();
   std::lock_guard<std::mutex> lock(*mutex_);
   wavog_mapping::VehicleStatus& c = v->c;
-  ++c.received;
-  c.bytes += ros::serialization::serializationLength(*m);
   v->last_receipt = now;
   if (v->stale_reported) {
     v->stale_reported = false;
     ROS_INFO("%s: vehicle '%s' streams again", pnh_.getNamespace().c_str(), v->name.c_str());
   }
-  // The index first: a message refused below was delivered, so it is not lost.
-  std::uint64_t skipped = 0;
-  switch (v->stream_index.step(m->index, &skipped)) {
-    case IndexStep::kGap:
-      c.lost = saturatingAdd(c.lost, skipped);
-      break;
-    case IndexStep::kRegress:
-      ++c.index_regressions;
-      warnLocked(v, "index " + std::to_string(m->index) + " at or below the previous one (" +
-                        std::to_string(c.index_regressions) +
-                        " so far: a duplicate or a restarted mapper; not counted as lost)");
-      break;
-    case IndexStep::kJump:
-      ++c.index_jumps;
-      warnLocked(v, "index " + std::to_string(m->index) + " more than 2^32 past the previous "
-                        "one (" + std::to_string(c.index_jumps) +
-                        " so far: a corrupt index; not counted as lost)");
-      break;
-    case IndexStep::kFirst:
-    case IndexStep::kNext:
-      break;
+  const Intake in = takeIn(*m, limits_, ros::Time::now(), &v->stream_index, &c);
+  if (in.step == IndexStep::kRegress) {
+    warnLocked(v, "index " + std::to_string(m->index) + " at or below the previous one (" +
+                      std::to_string(c.index_regressions) +
+                      " so far: a duplicate or a restarted mapper; not counted as lost)");
+  } else if (in.step == IndexStep::kJump) {
+    warnLocked(v, "index " + std::to_string(m->index) + " more than 2^32 past the previous "
+                      "one (" + std::to_string(c.index_jumps) +
+                      " so far: a corrupt index; not counted as lost)");
   }
-  std::string detail;
-  const Refusal r = checkPlacedScan(*m, limits_, ros::Time::now(), &detail);
-  if (r != Refusal::kNone) {
-    std::uint64_t* counter = r == Refusal::kVersion    ? &c.dropped_version
-                             : r == Refusal::kFrame    ? &c.dropped_frame
-                             : r == Refusal::kBadStamp ? &c.dropped_bad_stamp
-                             : r == Refusal::kBadPose  ? &c.dropped_bad_pose
-                                                       : &c.dropped_bad_size;
-    ++*counter;
-    warnLocked(v, std::string("message refused (") + toString(r) + ", " +
-                      std::to_string(*counter) + " so far): " + detail);
+  if (in.refusal != Refusal::kNone) {
+    warnLocked(v, std::string("message refused (") + toString(in.refusal) + ", " +
+                      std::to_string(*refusalCounter(in.refusal, &c)) + " so far): " + in.detail);
     return;
   }
   c.last_stamp = m->header.stamp;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "wavog_mapping/core/limits.h"
+#include "wavog_mapping/core/scan_period.h"
 #include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_fleet {
@@ -114,6 +115,12 @@ Refusal checkPlacedScan(const wavog_mapping::PlacedScan& m, const PlacedScanLimi
       << "]: the core takes 1 to " << wavog::kMaxBeams << " beams, |angle_min| <= "
       << wavog::kMaxAbsAngleMin << " rad, |angle_increment| >= " << wavog::kMinAbsAngleIncrement
       << " rad, beams x |angle_increment| <= 2 pi, range_max > range_min >= 0";
+    r = Refusal::kBadSize;
+  } else if (!(m.period >= 0.0 && m.period <= wavog::ScanPeriod::kMaxPeriod)) {
+    // No mapper sends it (wavog::ScanPeriod), and under forget_half_life a long one forgets
+    // every cell of the scan's fan at once. Negated: NaN is refused.
+    d << "period " << m.period << " s: a mapper sends 0 (unknown) or up to "
+      << wavog::ScanPeriod::kMaxPeriod << " s (ScanPeriod::kMaxPeriod)";
     r = Refusal::kBadSize;
   }
   if (detail) *detail = d.str();

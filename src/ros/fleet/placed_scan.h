@@ -23,7 +23,8 @@ enum class Refusal {
   kFrame,     ///< not in the fleet's map frame
   kBadStamp,  ///< stamp 0, nsec >= 1e9, or farther than max_stamp_offset from the fleet's clock
   kBadPose,   ///< a pose field (x, y, theta, start_*, end_*) not finite or outside the limits
-  kBadSize,   ///< the scan geometry outside the core's limits (beams, angles, range limits)
+  kBadSize,   ///< the scan geometry outside the core's limits (beams, angles, range limits),
+              ///< or a period outside [0, ScanPeriod::kMaxPeriod] (none a mapper sends)
 };
 const char* toString(Refusal r);
 

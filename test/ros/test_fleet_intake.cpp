@@ -1,0 +1,109 @@
+// The fleet node's intake of a vehicle's messages without a master (intake.h, issue 37): every
+// delivered message is received, refused ones by their reason and never as lost, `lost` counts
+// exactly the indices the stream skipped, a duplicate or regressing index and a jump beyond 2^32
+// are counted on their own, and no index makes a counter wrap.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "fleet/intake.h"
+#include "fleet/placed_scan.h"
+#include "fleet/stream_index.h"
+
+namespace {
+
+using wavog_fleet::IndexStep;
+using wavog_fleet::Refusal;
+
+const ros::Time kNow(100.0);
+
+wavog_mapping::PlacedScan goodScan(std::uint64_t index) {
+  const std::vector<float> ranges(181, 5.0f);
+  wavog::ScanView view;
+  view.ranges = ranges.data();
+  view.count = ranges.size();
+  view.angle_min = -M_PI / 2;
+  view.angle_increment = M_PI / 180;
+  view.range_min = 0.1;
+  view.range_max = 80.0;
+  wavog_mapping::PlacedScan m;
+  wavog_fleet::fillPlacedScan(kNow, "map", "v1", "/v1/scan", index, wavog::Pose2{1, 2, 0.5}, view,
+                              false, wavog::Pose2{1, 2, 0.5}, wavog::Pose2{1, 2, 0.5}, &m);
+  return m;
+}
+
+struct Stream {
+  wavog_fleet::StreamIndex index;
+  wavog_mapping::VehicleStatus c;
+  wavog_fleet::Intake take(const wavog_mapping::PlacedScan& m) {
+    return wavog_fleet::takeIn(m, wavog_fleet::PlacedScanLimits{}, kNow, &index, &c);
+  }
+};
+
+TEST(FleetIntake, RefusedMessagesAreDeliveredNotLost) {
+  Stream s;
+  EXPECT_EQ(s.take(goodScan(0)).refusal, Refusal::kNone);
+  // Indices 1..6, each refused by a check: all delivered.
+  auto m = goodScan(1);
+  m.version = 7;
+  EXPECT_EQ(s.take(m).refusal, Refusal::kVersion);
+  m = goodScan(2);
+  m.header.frame_id = "odom";
+  EXPECT_EQ(s.take(m).refusal, Refusal::kFrame);
+  m = goodScan(3);
+  m.header.stamp = kNow + ros::Duration(1e6);  // 11 days ahead
+  EXPECT_EQ(s.take(m).refusal, Refusal::kBadStamp);
+  m = goodScan(4);
+  m.end_x = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(s.take(m).refusal, Refusal::kBadPose);
+  m = goodScan(5);
+  m.angle_increment = 1e-310;
+  EXPECT_EQ(s.take(m).refusal, Refusal::kBadSize);
+  m = goodScan(6);
+  m.period = 1e300;  // under forget_half_life: every cell of its fan forgotten at once
+  EXPECT_EQ(s.take(m).refusal, Refusal::kBadSize);
+  const wavog_fleet::Intake last = s.take(goodScan(7));
+  EXPECT_EQ(last.refusal, Refusal::kNone);
+  EXPECT_EQ(last.step, IndexStep::kNext);
+  EXPECT_EQ(s.c.received, 8u);
+  EXPECT_GT(s.c.bytes, 8u * 181u * 4u);
+  EXPECT_EQ(s.c.lost, 0u);
+  EXPECT_EQ(s.c.dropped_bad_size, 2u);
+  EXPECT_EQ(s.c.dropped_version + s.c.dropped_frame + s.c.dropped_bad_stamp +
+                s.c.dropped_bad_pose + s.c.dropped_bad_size,
+            6u);
+  EXPECT_EQ(s.c.index_regressions + s.c.index_jumps, 0u);
+}
+
+TEST(FleetIntake, LostCountsExactlyTheSkippedIndices) {
+  Stream s;
+  s.take(goodScan(10));  // a stream may start anywhere (a fleet node started late)
+  EXPECT_EQ(s.take(goodScan(13)).step, IndexStep::kGap);
+  EXPECT_EQ(s.c.lost, 2u);
+  // A duplicate and a regression (a restarted mapper): counted, not lost; the sequence goes on.
+  EXPECT_EQ(s.take(goodScan(13)).step, IndexStep::kRegress);
+  EXPECT_EQ(s.take(goodScan(0)).step, IndexStep::kRegress);
+  EXPECT_EQ(s.take(goodScan(1)).step, IndexStep::kNext);
+  EXPECT_EQ(s.c.index_regressions, 2u);
+  EXPECT_EQ(s.c.lost, 2u);
+  // The largest gap still counted as lost, then a corrupt index (2^64 - 1) is a jump.
+  EXPECT_EQ(s.take(goodScan(2 + wavog_fleet::kMaxIndexGap)).step, IndexStep::kGap);
+  EXPECT_EQ(s.c.lost, 2u + wavog_fleet::kMaxIndexGap);
+  EXPECT_EQ(s.take(goodScan(std::numeric_limits<std::uint64_t>::max())).step, IndexStep::kJump);
+  EXPECT_EQ(s.c.index_jumps, 1u);
+  EXPECT_EQ(s.c.lost, 2u + wavog_fleet::kMaxIndexGap) << "a jump adds nothing to lost";
+  // After 2^64 - 1 every index regresses; nothing wraps.
+  EXPECT_EQ(s.take(goodScan(0)).step, IndexStep::kRegress);
+  EXPECT_EQ(s.c.received, 8u);
+}
+
+TEST(FleetIntake, LostSaturates) {
+  EXPECT_EQ(wavog_fleet::saturatingAdd(std::numeric_limits<std::uint64_t>::max() - 1, 5),
+            std::numeric_limits<std::uint64_t>::max());
+  EXPECT_EQ(wavog_fleet::saturatingAdd(3, 4), 7u);
+}
+
+}  // namespace
