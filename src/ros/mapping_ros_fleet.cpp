@@ -20,6 +20,10 @@ void MappingRos::Impl::startFleet(MapperRole role) {
       ROS_WARN("%s: fleet_vehicles is read by wavog_fleet only; this mapper ignores it",
                pnh_.getNamespace().c_str());
     }
+    if (!rp.fleet_region.empty()) {
+      throw std::invalid_argument("fleet_region must be empty ([]) for a mapper: only wavog_fleet "
+                                  "maps a region of the site");
+    }
     if (!rp.fleet_stream) return;  // nothing advertised, nothing queued
     std::string vehicle = rp.vehicle_id;
     if (vehicle.empty()) vehicle = nh_.getNamespace();
@@ -36,6 +40,11 @@ void MappingRos::Impl::startFleet(MapperRole role) {
     throw std::invalid_argument("publish_window (" + std::to_string(rp.publish_window) +
                                 ") must be 0 for wavog_fleet: the fleet map has no robot to "
                                 "centre a window on");
+  }
+  if (!rp.fleet_region.empty()) {
+    ROS_INFO("%s: region shard: integrating into [%g, %g] x [%g, %g] m only (fleet_region)",
+             pnh_.getNamespace().c_str(), rp.fleet_region[0], rp.fleet_region[2],
+             rp.fleet_region[1], rp.fleet_region[3]);
   }
   // No tf input: an empty buffer keeps the shared paths (publication, flush) valid.
   buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(rp.tf_cache_time));
