@@ -207,6 +207,8 @@ const std::vector<KeyReader>& readers() {
        [](auto& k, auto& v, Config* c) { c->ros.fleet_max_buffered = asInt(k, v); }},
       {"fleet_max_stamp_offset",
        [](auto& k, auto& v, Config* c) { c->ros.fleet_max_stamp_offset = asDouble(k, v); }},
+      {"fleet_window",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_window = asDouble(k, v); }},
       {"fleet_region",
        [](auto& k, auto& v, Config* c) { c->ros.fleet_region = asDoubleList(k, v); }},
   };
@@ -365,6 +367,12 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
             ros.fleet_max_stamp_offset <= 86400.0,
         &e, "fleet_max_stamp_offset (" + fmt(ros.fleet_max_stamp_offset) +
                 ") must be in (0, 86400] s");
+  // A window of half-width w holds (2 w / resolution + 2)^2 cells at most (kMaxLayerCells).
+  const double max_window = 0.5 * (4096.0 - 2.0) * map.grid.resolution;  // 4096^2 = 2^24 cells
+  check(std::isfinite(ros.fleet_window) && ros.fleet_window >= 0.0 &&
+            ros.fleet_window <= max_window,
+        &e, "fleet_window (" + fmt(ros.fleet_window) + ") must be in [0, " + fmt(max_window) +
+                "] m (0: off; the window must hold at most 2^24 cells)");
   if (!ros.fleet_region.empty()) {
     std::string why;
     wavog::BlockRegion r;

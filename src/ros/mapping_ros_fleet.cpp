@@ -9,6 +9,7 @@
 
 #include "fleet/fleet_receiver.h"
 #include "fleet/fleet_stream.h"
+#include "fleet/vehicle_windows.h"
 #include "mapping_ros_impl.h"
 
 namespace wavog_ros {
@@ -54,6 +55,10 @@ void MappingRos::Impl::startFleet(MapperRole role) {
         return integratePlacedLocked(pose, view);
       },
       updater_.get());
+  if (rp.fleet_window > 0.0) {
+    fleet_windows_ =
+        std::make_unique<wavog_fleet::VehicleWindows>(nh_, rp.fleet_vehicles, rp.fleet_window);
+  }
 }
 
 wavog::IntegrateStats MappingRos::Impl::integratePlacedLocked(const wavog::Pose2& pose,
@@ -69,10 +74,12 @@ wavog::IntegrateStats MappingRos::Impl::integratePlacedLocked(const wavog::Pose2
   if (st.status != wavog::ScanStatus::kOk) return st;
   changed_since_publish_ = true;
   const double res = map_.resolution();
-  publisher_->touched({static_cast<double>(st.touched.min_x) * res,
-                       static_cast<double>(st.touched.min_y) * res,
-                       static_cast<double>(st.touched.max_x) * res,
-                       static_cast<double>(st.touched.max_y) * res});
+  const MapBox box{static_cast<double>(st.touched.min_x) * res,
+                   static_cast<double>(st.touched.min_y) * res,
+                   static_cast<double>(st.touched.max_x) * res,
+                   static_cast<double>(st.touched.max_y) * res};
+  publisher_->touched(box);
+  if (fleet_windows_) fleet_windows_->touched(box);
   return st;
 }
 

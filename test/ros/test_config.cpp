@@ -180,6 +180,16 @@ TEST(Config, FleetRegionIsTheCoresBlockRegionOrAClearError) {
             std::string::npos);
 }
 
+TEST(Config, FleetWindowIsBoundedByTheLayerLimit) {
+  EXPECT_EQ(fromYaml("{}").ros.fleet_window, 0.0);  // off by default
+  EXPECT_EQ(fromYaml("{fleet_window: 25}").ros.fleet_window, 25.0);
+  // 4094 cells of 5 cm / 2: 102.35 m.
+  EXPECT_NE(errorOf("{fleet_window: 103}").find("fleet_window (103) must be in [0, 102.35] m"),
+            std::string::npos)
+      << errorOf("{fleet_window: 103}");
+  EXPECT_NE(errorOf("{fleet_window: -1}").find("fleet_window"), std::string::npos);
+}
+
 TEST(Config, ReportsUnknownKeys) {
   std::vector<std::string> unknown;
   fromYaml("{resolutoin: 0.1, publish_rate: 2}", &unknown);

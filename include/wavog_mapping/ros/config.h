@@ -103,6 +103,10 @@ struct RosParams {
   /// integrates every vehicle's scans into the blocks of this rectangle only (MapParams::region).
   /// Empty: everything (one fleet node for the site).
   std::vector<double> fleet_region;
+  /// Fleet node: half-width (m) of the square around each vehicle's latest streamed position in
+  /// which it publishes its finest layer back to the vehicle (<ns>/fleet_map, _updates); 0: off.
+  /// At most the half-width whose window holds kMaxLayerCells cells.
+  double fleet_window = 0.0;
 };
 
 /// Most vehicles one fleet node follows.

@@ -37,6 +37,8 @@ struct FleetReceiver::Vehicle {
   double lag_max_period = 0.0;
   ros::Time oldest_unpublished;  ///< stamp of the oldest scan integrated since the last layers
   double publish_lag_max_period = 0.0;
+  bool has_position = false;  ///< x, y: the latest integrated scan's sensor position
+  double x = 0.0, y = 0.0;
 };
 
 FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
@@ -190,6 +192,9 @@ void FleetReceiver::integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan&
     return;
   }
   ++c.integrated;
+  v->has_position = true;
+  v->x = m.x;
+  v->y = m.y;
   if (integrated_stamp_ < m.header.stamp) integrated_stamp_ = m.header.stamp;
   // In double seconds: ros::Time's operator- throws beyond 2^31 s (the stamp passed
   // fleet_max_stamp_offset, but the clock may have jumped since).
@@ -208,6 +213,13 @@ void FleetReceiver::layersPublishedLocked(const ros::Time& now) {
         std::max(v->publish_lag_max_period, wavog_ros::secondsBetween(now, v->oldest_unpublished));
     v->oldest_unpublished = ros::Time();
   }
+}
+
+bool FleetReceiver::latestPositionLocked(std::size_t i, double* x, double* y) const {
+  if (i >= vehicles_.size() || !vehicles_[i]->has_position) return false;
+  *x = vehicles_[i]->x;
+  *y = vehicles_[i]->y;
+  return true;
 }
 
 std::uint64_t FleetReceiver::integratedLocked() const {
