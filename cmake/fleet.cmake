@@ -27,6 +27,7 @@ add_executable(wavog_site src/ros/fleet/site_node.cpp src/ros/fleet/site_layers.
 target_link_libraries(wavog_site PRIVATE ${catkin_LIBRARIES})
 target_include_directories(wavog_site SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_compile_options(wavog_site PRIVATE ${WAVOG_WARNINGS})
+add_dependencies(wavog_site ${PROJECT_NAME}_generate_messages_cpp)
 set_target_properties(wavog_site PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 
@@ -76,6 +77,7 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_sim)
   add_rostest_gtest(test_fleet_shards test/fleet_shards.test test/ros/test_fleet_shards.cpp)
   target_link_libraries(test_fleet_shards wavog_ros_config wavog_sim wavog_core ${catkin_LIBRARIES}
                         ${GTEST_LIBRARIES})
-  target_compile_definitions(test_fleet_shards PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  target_compile_definitions(test_fleet_shards PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+    WAVOG_FLEET_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_fleet")
   add_dependencies(test_fleet_shards ${PROJECT_NAME}_generate_messages_cpp wavog_fleet wavog_site)
 endif()

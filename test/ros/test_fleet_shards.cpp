@@ -4,8 +4,9 @@
 // addresses. Checks: the shards' saved maps together equal the unsharded one, cell for cell (every
 // finest cell and every scale, as floats); the window /v1/fleet_map equals the unsharded fleet map
 // inside it (and its updates apply to it); wavog_site's site_map_scale_3 equals the unsharded
-// map_scale_3; a shard restarted from its own ~save_map holds that map exactly. Prints the bytes
-// of each vehicle's window.
+// map_scale_3; a fourth vehicle 1 km east of the car park, outside every region, is counted by
+// each shard (outside_region) and mapped by none (only by the unsharded node); a shard restarted
+// from its own ~save_map holds that map exactly. Prints the bytes of a vehicle's window.
 #include <gtest/gtest.h>
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -35,6 +36,33 @@ namespace {
 
 constexpr double kDuration = 5.0;  // s of each vehicle's drive
 const std::vector<std::string> kNodes = {"/all", "/shard_a", "/shard_b"};
+constexpr double kFarEast = 1000.0;  // m: v4 is v1 this far east
+
+/// Starts `args` with ROS_HOSTNAME `host` (no ROS_IP, see test/fleet.test).
+pid_t spawn(const std::vector<std::string>& args, const std::string& host) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    unsetenv("ROS_IP");
+    setenv("ROS_HOSTNAME", host.c_str(), 1);
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execvp(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+void stop(pid_t pid) {
+  if (pid <= 0) return;
+  kill(pid, SIGINT);
+  for (int i = 0; i < 100; ++i) {
+    if (waitpid(pid, nullptr, WNOHANG) == pid) return;
+    usleep(100000);
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+}
 
 /// One placed scan as a mapper streams it (fleet_stream.cpp fills the same fields).
 struct Streamed {
@@ -73,6 +101,18 @@ std::vector<Streamed> fleetScans(int vehicles) {
       p.msg.period = 1.0 / laser.rate_hz;
       out.push_back(std::move(p));
     }
+  }
+  // v4: v1's scans, placed 1 km further east.
+  const std::size_t n = out.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (out[i].vehicle != 0) continue;
+    Streamed p = out[i];
+    p.vehicle = 3;
+    p.msg.vehicle = "v4";
+    p.msg.x += kFarEast;
+    p.msg.start_x += kFarEast;
+    p.msg.end_x += kFarEast;
+    out.push_back(std::move(p));
   }
   std::stable_sort(out.begin(), out.end(),
                    [](const Streamed& a, const Streamed& b) { return a.t < b.t; });
@@ -113,15 +153,22 @@ int cellOf(const nav_msgs::OccupancyGrid& g, std::int64_t ix, std::int64_t iy) {
   return g.data[static_cast<std::size_t>(y * g.info.width + x)];
 }
 
-/// Cells of `a` (all of them) that differ from `b` at the same place, and the known ones.
+/// Cells of `a` that differ from `b` at the same place, and the known ones; only those of lattice
+/// indices within `only` when it is not empty.
 std::pair<std::size_t, std::size_t> gridDiff(const nav_msgs::OccupancyGrid& a,
-                                             const nav_msgs::OccupancyGrid& b) {
+                                             const nav_msgs::OccupancyGrid& b,
+                                             const wavog::CellBox& only = wavog::CellBox{}) {
   std::size_t differ = 0, known = 0;
   const double res = a.info.resolution;
   const auto x0 = static_cast<std::int64_t>(std::llround(a.info.origin.position.x / res));
   const auto y0 = static_cast<std::int64_t>(std::llround(a.info.origin.position.y / res));
   for (std::uint32_t y = 0; y < a.info.height; ++y) {
     for (std::uint32_t x = 0; x < a.info.width; ++x) {
+      const std::int64_t ix = x0 + x, iy = y0 + y;
+      if (!only.empty() &&
+          (ix < only.min_x || ix >= only.max_x || iy < only.min_y || iy >= only.max_y)) {
+        continue;
+      }
       const int v = a.data[y * a.info.width + x];
       known += v != -1;
       differ += v != cellOf(b, x0 + x, y0 + y);
@@ -136,9 +183,11 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
       wavog_ros::loadConfigFile(std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_shard.yaml", nullptr);
   const std::vector<Streamed> scans = fleetScans(3);
   ASSERT_GT(scans.size(), 1500u);
+  std::size_t v4_scans = 0;
+  for (const Streamed& s : scans) v4_scans += s.vehicle == 3;
 
   std::vector<ros::Publisher> pubs;
-  for (int k = 1; k <= 3; ++k) {
+  for (int k = 1; k <= 4; ++k) {
     pubs.push_back(nh.advertise<wavog_mapping::PlacedScan>("/v" + std::to_string(k) +
                                                            "/fleet_scans", 5000));
   }
@@ -205,8 +254,16 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
     for (const auto& v : status[i].get()->vehicles) {
       EXPECT_EQ(v.integrated_late, 0u) << kNodes[static_cast<std::size_t>(i)] << " " << v.vehicle;
       EXPECT_EQ(v.lost, 0u) << kNodes[static_cast<std::size_t>(i)] << " " << v.vehicle;
+      // v4 is outside every region: each shard counts all its scans, and no other vehicle's
+      // latest scan (all in the car park) missed both shards.
+      if (i > 0 && v.vehicle == "/v4") {
+        EXPECT_EQ(v.outside_region, v4_scans) << kNodes[static_cast<std::size_t>(i)];
+        EXPECT_FALSE(v.in_region);
+      }
+      if (i == 0) EXPECT_EQ(v.outside_region, 0u);  // no region
     }
   }
+  ASSERT_EQ(status[0].get()->vehicles.size(), 4u);
 
   // ---- the shard rule: the saved maps, as floats, every cell at every scale.
   const std::string stem = "/tmp/wavog_fleet_shards_" + std::to_string(getpid());
@@ -221,9 +278,11 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   const int L = params.grid.block_levels;
   const std::int64_t split = 6;  // blocks: x = 38.4 m
   std::size_t observed = 0;
+  // The regions' union, blocks [-10, 22) x [-10, 16) (fleet_shards.test); v4's cells lie east of
+  // it, in the unsharded map only.
   for (int s = 0; s <= L; ++s) {
-    wavog::CellBox box;
-    ASSERT_TRUE(whole.bounds(s, &box));
+    const wavog::CellBox box{-10LL << (L - s), -10LL << (L - s), 22LL << (L - s),
+                             16LL << (L - s)};
     const wavog::Raster w = whole.exportScale(s, box, wavog::Aggregation::kMean);
     const wavog::Raster a = maps[1].exportScale(s, box, wavog::Aggregation::kMean);
     const wavog::Raster b = maps[2].exportScale(s, box, wavog::Aggregation::kMean);
@@ -243,6 +302,17 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
     EXPECT_EQ(differ, 0u) << "scale " << s << ": cells that differ of " << w.log_odds.size();
   }
   EXPECT_GT(observed, 100000u);
+  // v4's cells: in the unsharded map, in no shard.
+  const wavog::CellBox east = whole.boxAround(kFarEast - 5.0, 0.0, kFarEast + 75.0, 34.0, 0);
+  EXPECT_GT(whole.exportScale(0, east, wavog::Aggregation::kMean).log_odds.size(), 0u);
+  std::size_t east_known = 0;
+  for (std::uint8_t k : whole.exportScale(0, east, wavog::Aggregation::kMean).known) east_known += k;
+  EXPECT_GT(east_known, 10000u);
+  wavog::CellBox shard_box;
+  for (int i = 1; i <= 2; ++i) {
+    ASSERT_TRUE(maps[static_cast<std::size_t>(i)].bounds(0, &shard_box));
+    EXPECT_LE(shard_box.max_x, 22LL << L) << kNodes[static_cast<std::size_t>(i)];
+  }
   EXPECT_GT(maps[1].stats(true).observed_cells, 10000u);  // both shards hold a real part
   EXPECT_GT(maps[2].stats(true).observed_cells, 10000u);
 
@@ -270,7 +340,9 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   const auto site = site_scale.get();
   const auto scale = all_scale.get();
   const auto [site_differ, site_known] = gridDiff(*site, *scale);
-  const auto [scale_differ, scale_known] = gridDiff(*scale, *site);
+  // Within the regions (v4's cells, east of them, are the unsharded node's only).
+  const auto [scale_differ, scale_known] =
+      gridDiff(*scale, *site, wavog::CellBox{-10LL << 3, -10LL << 3, 22LL << 3, 16LL << 3});
   EXPECT_EQ(site_differ, 0u) << "of " << site->data.size();
   EXPECT_EQ(scale_differ, 0u) << "of " << scale->data.size();
   EXPECT_GT(site_known, 1000u);
@@ -280,6 +352,47 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
               win->info.width, win->info.height, window.count, window.bytes, window_update.count,
               window_update.bytes, scans.size(), kDuration);
   EXPECT_GT(window_update.count, 0u);
+
+  // ---- a shard restarts and catches up from its own ~save_map (map_file): its map is that map,
+  // cell for cell, before any scan reaches it.
+  {
+    const std::string saved = stem + "shard_b.wmap";
+    const pid_t loader = spawn({"rosparam", "load",
+                                std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_shard.yaml",
+                                "/restarted/wavog_fleet"},
+                               "127.0.0.6");
+    int code = -1;
+    ASSERT_EQ(waitpid(loader, &code, 0), loader);
+    ASSERT_TRUE(WIFEXITED(code) && WEXITSTATUS(code) == 0);
+    ros::param::set("/restarted/wavog_fleet/fleet_region",
+                    std::vector<double>{38.4, -64.0, 140.8, 102.4});
+    ros::param::set("/restarted/wavog_fleet/map_file", saved);
+    const pid_t restarted =
+        spawn({WAVOG_FLEET_BIN, "__ns:=/restarted", "__name:=wavog_fleet"}, "127.0.0.4");
+    const bool ok = saveMap("/restarted/wavog_fleet/save_map", stem + "restarted.wmap");
+    stop(restarted);
+    ASSERT_TRUE(ok);
+    wavog::WaveletMap again(params);
+    again.load(stem + "restarted.wmap");
+    wavog::CellBox ba, bb;
+    ASSERT_TRUE(maps[2].bounds(0, &bb));
+    ASSERT_TRUE(again.bounds(0, &ba));
+    ASSERT_TRUE(ba.min_x == bb.min_x && ba.min_y == bb.min_y && ba.max_x == bb.max_x &&
+                ba.max_y == bb.max_y);
+    const wavog::Raster ra = again.exportScale(0, ba, wavog::Aggregation::kMean);
+    const wavog::Raster rb = maps[2].exportScale(0, bb, wavog::Aggregation::kMean);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < ra.log_odds.size(); ++i) {
+      differ += ra.known[i] != rb.known[i] ||
+                std::memcmp(&ra.log_odds[i], &rb.log_odds[i], sizeof(float)) != 0;
+    }
+    EXPECT_EQ(differ, 0u) << "of " << ra.log_odds.size();
+  }
+  for (const std::string& name : {"all", "shard_a", "shard_b", "restarted"}) {
+    for (const std::string& suffix : {".wmap", "_s0.pgm", "_s0.yaml", "_s3.pgm", "_s3.yaml"}) {
+      std::remove((stem + name + suffix).c_str());
+    }
+  }
 }
 
 }  // namespace

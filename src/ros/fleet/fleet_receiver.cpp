@@ -192,6 +192,8 @@ void FleetReceiver::integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan&
     return;
   }
   ++c.integrated;
+  if (st.outside_region) c.outside_region = saturatingAdd(c.outside_region, 1);
+  c.in_region = !st.outside_region;
   v->has_position = true;
   v->x = m.x;
   v->y = m.y;
@@ -281,6 +283,7 @@ void FleetReceiver::diagnose(const Vehicle* v, diagnostic_updater::DiagnosticSta
   stat.add("integrated", c.integrated);
   stat.add("integrated late", c.integrated_late);
   stat.add("lost", c.lost);
+  stat.add("outside region", c.outside_region);
   stat.add("index regressions", c.index_regressions);
   stat.add("index jumps", c.index_jumps);
   stat.add("dropped late", c.dropped_late);

@@ -1,7 +1,10 @@
 // wavog_site: a site's coarse layers from its region shards (issue 36). Subscribes to
 // <shard>/map_scale_<s> of every shard in ~shards and every scale in ~scales, and publishes their
 // union as site_map_scale_<s> (latched; site_layers.h) at ~rate Hz when a shard's layer changed,
-// so that a dispatcher sees the whole site without the fine grid of all of it. Bad parameters
+// so that a dispatcher sees the whole site without the fine grid of all of it. It also follows
+// each shard's <shard>/wavog_fleet/fleet_status and warns (throttled, per vehicle) about a vehicle
+// whose latest scan reached no shard's region: outside every region, its scans are mapped by no
+// shard (each shard counts them, VehicleStatus.outside_region). Bad parameters
 // fail at start-up, naming the parameter; layers that do not fit together are warned (throttled)
 // and not published.
 #include <nav_msgs/OccupancyGrid.h>
@@ -13,6 +16,7 @@
 #include <vector>
 
 #include "site_layers.h"
+#include "wavog_mapping/FleetStatus.h"
 
 namespace {
 
@@ -71,6 +75,38 @@ int main(int argc, char** argv) {
           }));
     }
   }
+  // Per shard, the latest ~fleet_status.
+  std::vector<wavog_mapping::FleetStatus::ConstPtr> statuses(shards.size());
+  std::vector<ros::Subscriber> status_subs;
+  for (std::size_t i = 0; i < shards.size(); ++i) {
+    status_subs.push_back(nh.subscribe<wavog_mapping::FleetStatus>(
+        ros::names::append(shards[i], "wavog_fleet/fleet_status"), 2,
+        [&statuses, i](const wavog_mapping::FleetStatus::ConstPtr& m) { statuses[i] = m; }));
+  }
+  std::map<std::string, ros::WallTime> warned;
+  ros::WallTimer status_timer = nh.createWallTimer(ros::WallDuration(1.0), [&](const ros::WallTimerEvent&) {
+    std::map<std::string, int> in, seen;
+    std::map<std::string, std::string> counts;
+    for (std::size_t i = 0; i < shards.size(); ++i) {
+      if (!statuses[i]) return;  // not every shard heard from yet
+      for (const auto& v : statuses[i]->vehicles) {
+        if (v.integrated == 0 || v.stale) continue;
+        ++seen[v.vehicle];
+        in[v.vehicle] += v.in_region ? 1 : 0;
+        counts[v.vehicle] += " " + shards[i] + ": " + std::to_string(v.outside_region);
+      }
+    }
+    const ros::WallTime now = ros::WallTime::now();
+    for (const auto& kv : seen) {
+      if (kv.second != static_cast<int>(shards.size()) || in[kv.first] > 0) continue;
+      auto it = warned.find(kv.first);
+      if (it != warned.end() && (now - it->second).toSec() < 5.0) continue;
+      warned[kv.first] = now;
+      ROS_WARN("wavog_site: vehicle '%s' is outside every region: its latest scan reached no "
+               "shard, its scans there are mapped by none (outside_region per shard:%s)",
+               kv.first.c_str(), counts[kv.first].c_str());
+    }
+  });
   ros::WallTimer timer = nh.createWallTimer(ros::WallDuration(1.0 / rate), [&](const ros::WallTimerEvent&) {
     for (auto& kv : layers) {
       Scale& l = kv.second;
