@@ -44,7 +44,7 @@ bool assembleSiteLayer(const std::vector<const nav_msgs::OccupancyGrid*>& parts,
       *why = "the shards' layers differ in resolution or frame";
       return false;
     }
-    if (out->header.stamp < g->header.stamp) out->header.stamp = g->header.stamp;
+    if (g->header.stamp < out->header.stamp) out->header.stamp = g->header.stamp;
     Part p{g, 0, 0};
     if (!latticeIndex(g->info.origin.position.x, res, &p.x0) ||
         !latticeIndex(g->info.origin.position.y, res, &p.y0)) {

@@ -16,7 +16,8 @@ namespace wavog_fleet {
 /// Puts `parts` (the shards' layers of one scale, in one frame) together into `out`: the
 /// smallest grid holding every part's known cells (-1 elsewhere), each part's known cells copied
 /// (where two parts know a cell, the later one wins: overlapping regions are a configuration
-/// error). The header is the newest part's. False, with *why, when the parts do not share one
+/// error). The header is the oldest part's: the site layer holds every shard's map as of at least
+/// that stamp. False, with *why, when the parts do not share one
 /// frame, resolution and cell lattice (origins a whole number of cells apart), or none has a
 /// known cell (then out is an empty grid).
 bool assembleSiteLayer(const std::vector<const nav_msgs::OccupancyGrid*>& parts,
