@@ -101,6 +101,7 @@ def run(g, bag, n, shards, rate):
             g.param("set", ns + "/fleet_vehicles", "[%s]" % ", ".join("/" + v for v in vehicles))
             g.param("set", ns + "/block_levels", "7")
             g.param("set", ns + "/publish_scales", "[3]")
+            g.param("set", ns + "/map_dir", OUT)  # ~save_map writes there
             g.param("set", ns + "/fleet_region", "[%s]" % ", ".join("%g" % x for x in region))
             nodes.append(g.start([os.path.join(BIN, "wavog_fleet"), "__ns:=/s%d" % i,
                                   "__name:=wavog_fleet"]))
@@ -130,7 +131,8 @@ def run(g, bag, n, shards, rate):
         cpu = [cpu_seconds(p.pid) - c for p, c in zip(nodes, cpu0)]
         from wavog_mapping.srv import SaveMap
         for i in range(shards):  # publishes the last fleet_status (the clock stopped)
-            rospy.ServiceProxy("/s%d/wavog_fleet/save_map" % i, SaveMap)(path="shard_bench.wavog")
+            rospy.ServiceProxy("/s%d/wavog_fleet/save_map" % i, SaveMap)(
+                path="shard%d.wavog" % i)
         time.sleep(1.0)
         out = []
         for i in range(shards):
