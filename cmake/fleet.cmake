@@ -10,7 +10,8 @@ target_sources(wavog_ros PRIVATE
   src/ros/fleet/placed_scan.cpp
   src/ros/fleet/intake.cpp
   src/ros/fleet/fleet_stream.cpp
-  src/ros/fleet/fleet_receiver.cpp)
+  src/ros/fleet/fleet_receiver.cpp
+  src/ros/fleet/vehicle_windows.cpp)
 
 add_library(wavog_fleet_nodelet src/ros/fleet/fleet_nodelet.cpp)
 target_link_libraries(wavog_fleet_nodelet PRIVATE wavog_ros)
@@ -20,6 +21,15 @@ add_executable(wavog_fleet src/ros/fleet/fleet_node.cpp)
 target_link_libraries(wavog_fleet PRIVATE wavog_ros)
 target_compile_options(wavog_fleet PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_fleet PROPERTIES
+  RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+
+# wavog_site: the shards' coarse layers put together (issue 36).
+add_executable(wavog_site src/ros/fleet/site_node.cpp src/ros/fleet/site_layers.cpp)
+target_link_libraries(wavog_site PRIVATE ${catkin_LIBRARIES})
+target_include_directories(wavog_site SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+target_compile_options(wavog_site PRIVATE ${WAVOG_WARNINGS})
+add_dependencies(wavog_site ${PROJECT_NAME}_generate_messages_cpp)
+set_target_properties(wavog_site PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
@@ -76,4 +86,14 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet)
   target_link_libraries(test_fleet_map_services wavog_ros_includes ${catkin_LIBRARIES}
                         ${GTEST_LIBRARIES})
   add_dependencies(test_fleet_map_services ${PROJECT_NAME}_generate_messages_cpp wavog_fleet)
+endif()
+
+# ---- Region shards (test/fleet_shards.test, issue 36): 2 shards, 1 unsharded node, wavog_site ----
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_sim)
+  add_rostest_gtest(test_fleet_shards test/fleet_shards.test test/ros/test_fleet_shards.cpp)
+  target_link_libraries(test_fleet_shards wavog_ros_config wavog_sim wavog_core ${catkin_LIBRARIES}
+                        ${GTEST_LIBRARIES})
+  target_compile_definitions(test_fleet_shards PRIVATE WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+    WAVOG_FLEET_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_fleet")
+  add_dependencies(test_fleet_shards ${PROJECT_NAME}_generate_messages_cpp wavog_fleet wavog_site)
 endif()

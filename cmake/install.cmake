@@ -11,10 +11,10 @@
 if(WAVOG_BUILD_ROS)
   # Programs. The project's shared libraries are found beside the program's directory without a
   # sourced setup file too (relocatable: relative to the program).
-  set(_wavog_programs wavog_mapping_node wavog_fleet wavog_static_tf wavog_offline wavog_log2bag
+  set(_wavog_programs wavog_mapping_node wavog_fleet wavog_site wavog_static_tf wavog_offline wavog_log2bag
                       wavog_simulate wavog_evaluate wavog_paper)
   set_target_properties(${_wavog_programs} PROPERTIES INSTALL_RPATH "$ORIGIN/..")
-  install(TARGETS wavog_mapping_node wavog_fleet wavog_static_tf wavog_offline wavog_log2bag
+  install(TARGETS wavog_mapping_node wavog_fleet wavog_site wavog_static_tf wavog_offline wavog_log2bag
                   wavog_simulate wavog_evaluate wavog_paper
           RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
   if(TARGET wavog_compare)  # with OctoMap only

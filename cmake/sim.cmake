@@ -38,6 +38,9 @@ target_include_directories(wavog_simulate SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(wavog_simulate PRIVATE wavog_sim wavog_io wavog_tool_support ${catkin_LIBRARIES})
 target_compile_options(wavog_simulate PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_simulate PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_SIM_BIN_DIR})
+if(TARGET ${PROJECT_NAME}_generate_messages_cpp)  # --placed-scans writes PlacedScan
+  add_dependencies(wavog_simulate ${PROJECT_NAME}_generate_messages_cpp)
+endif()
 
 # ---- wavog_evaluate: every policy over a scenario against ground truth (no ROS at run time) ---
 add_executable(wavog_evaluate src/tools/evaluate.cpp src/tools/evaluate_output.cpp)

@@ -34,3 +34,20 @@ fleet-bench: build
 	@bash -c 'source $(BUILD)/devel/setup.bash && /usr/bin/python3 $(ROOT)/scripts/fleet_bench.py \
 	  $(BUILD)/devel/lib/wavog_mapping $(ROOT) $(FLEET_BENCH_OUT) $(FLEET_BENCH_DURATION) \
 	  $(FLEET_BENCH_RATES)'
+
+# `make fleet-shard-bench` (issue 36): 8, 16 and 32 simulated vehicles' placed-scan streams
+# (wavog_simulate --placed-scans) into 1, 2 and 4 region shards at 1x and 2x real time: CPU per
+# shard, late / lost / refused, lag, kept up or not. Writes FLEET_BENCH_OUT/shard_bench.md and
+# shard_bench.json. About 6 minutes after the build.
+FLEET_SHARD_VEHICLES ?= 8,16,32
+FLEET_SHARDS ?= 1,2,4
+FLEET_SHARD_RATES ?= 1,2
+FLEET_SHARD_DURATION ?= 10
+
+.PHONY: fleet-shard-bench
+fleet-shard-bench: build
+	@mkdir -p $(FLEET_BENCH_OUT)
+	@bash -c 'source $(BUILD)/devel/setup.bash && /usr/bin/python3 \
+	  $(ROOT)/scripts/fleet_shard_bench.py $(BUILD)/devel/lib/wavog_mapping $(ROOT) \
+	  $(FLEET_BENCH_OUT) $(FLEET_SHARD_DURATION) $(FLEET_SHARD_VEHICLES) $(FLEET_SHARDS) \
+	  $(FLEET_SHARD_RATES)'

@@ -103,6 +103,13 @@ std::vector<std::string> asStringList(const std::string& key, XmlRpcValue& v) {
   return out;
 }
 
+std::vector<double> asDoubleList(const std::string& key, XmlRpcValue& v) {
+  if (v.getType() != XmlRpcValue::TypeArray) typeError(key, v, "a list of numbers");
+  std::vector<double> out;
+  for (int i = 0; i < v.size(); ++i) out.push_back(asDouble(key + "[" + std::to_string(i) + "]", v[i]));
+  return out;
+}
+
 /// Reads one key into a Config.
 struct KeyReader {
   const char* key;
@@ -200,6 +207,10 @@ const std::vector<KeyReader>& readers() {
        [](auto& k, auto& v, Config* c) { c->ros.fleet_max_buffered = asInt(k, v); }},
       {"fleet_max_stamp_offset",
        [](auto& k, auto& v, Config* c) { c->ros.fleet_max_stamp_offset = asDouble(k, v); }},
+      {"fleet_window",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_window = asDouble(k, v); }},
+      {"fleet_region",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_region = asDoubleList(k, v); }},
   };
   return kReaders;
 }
@@ -356,7 +367,55 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
             ros.fleet_max_stamp_offset <= 86400.0,
         &e, "fleet_max_stamp_offset (" + fmt(ros.fleet_max_stamp_offset) +
                 ") must be in (0, 86400] s");
+  // A window of half-width w holds (2 w / resolution + 2)^2 cells at most (kMaxLayerCells).
+  const double max_window = 0.5 * (4096.0 - 2.0) * map.grid.resolution;  // 4096^2 = 2^24 cells
+  check(std::isfinite(ros.fleet_window) && ros.fleet_window >= 0.0 &&
+            ros.fleet_window <= max_window,
+        &e, "fleet_window (" + fmt(ros.fleet_window) + ") must be in [0, " + fmt(max_window) +
+                "] m (0: off; the window must hold at most 2^24 cells)");
+  if (!ros.fleet_region.empty()) {
+    std::string why;
+    wavog::BlockRegion r;
+    if (ros.fleet_region.size() != 4) {
+      why = "it has " + std::to_string(ros.fleet_region.size()) + " values";
+    } else {
+      fleetRegionBlocks(ros.fleet_region, map.grid, &r, &why);
+    }
+    check(why.empty(), &e,
+          "fleet_region must be [] (everything) or [min_x, min_y, max_x, max_y] in m, min < max, "
+          "each a multiple of the block size (resolution x 2^block_levels = " +
+              fmt(map.grid.resolution * std::ldexp(1.0, map.grid.block_levels)) + " m): " + why);
+  }
   return e;
+}
+
+bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParams& grid,
+                       wavog::BlockRegion* out, std::string* why) {
+  const double block = grid.resolution * std::ldexp(1.0, grid.block_levels);
+  std::int64_t b[4] = {0, 0, 0, 0};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const double k = region[i] / block;
+    if (!std::isfinite(k) || std::abs(k) > 1e12) {
+      *why = "value " + fmt(region[i]) + " is not a finite coordinate";
+      return false;
+    }
+    const double rounded = std::round(k);
+    if (std::abs(k - rounded) > 1e-6) {
+      *why = "value " + fmt(region[i]) + " is not a multiple of " + fmt(block) + " m";
+      return false;
+    }
+    b[i] = static_cast<std::int64_t>(rounded);
+  }
+  if (!(b[0] < b[2] && b[1] < b[3])) {
+    *why = "min must be below max on both axes";
+    return false;
+  }
+  out->all = false;
+  out->min_bx = b[0];
+  out->min_by = b[1];
+  out->max_bx = b[2];
+  out->max_by = b[3];
+  return true;
 }
 
 Config configFromXmlRpc(XmlRpc::XmlRpcValue& root, std::vector<std::string>* unknown_keys) {
@@ -390,6 +449,12 @@ Config configFromXmlRpc(XmlRpc::XmlRpcValue& root, std::vector<std::string>* unk
     }
   }
 
+  if (config.ros.fleet_region.size() == 4) {
+    // The core's region (its extent is checked by MapParams::validate; the form by validate()).
+    std::string why;
+    wavog::BlockRegion r;
+    if (fleetRegionBlocks(config.ros.fleet_region, config.map.grid, &r, &why)) config.map.region = r;
+  }
   std::vector<std::string> errors = config.map.validate();
   const std::vector<std::string> ros_errors = validate(config.ros, config.map);
   errors.insert(errors.end(), ros_errors.begin(), ros_errors.end());

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "fleet/fleet_receiver.h"
+#include "fleet/vehicle_windows.h"
 #include "fleet/fleet_stream.h"
 #include "mapping_ros_impl.h"
 #include "reconfigure.h"

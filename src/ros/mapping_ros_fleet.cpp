@@ -9,6 +9,7 @@
 
 #include "fleet/fleet_receiver.h"
 #include "fleet/fleet_stream.h"
+#include "fleet/vehicle_windows.h"
 #include "mapping_ros_impl.h"
 
 namespace wavog_ros {
@@ -19,6 +20,10 @@ void MappingRos::Impl::startFleet(MapperRole role) {
     if (!rp.fleet_vehicles.empty()) {
       ROS_WARN("%s: fleet_vehicles is read by wavog_fleet only; this mapper ignores it",
                pnh_.getNamespace().c_str());
+    }
+    if (!rp.fleet_region.empty()) {
+      throw std::invalid_argument("fleet_region must be empty ([]) for a mapper: only wavog_fleet "
+                                  "maps a region of the site");
     }
     if (!rp.fleet_stream) return;  // nothing advertised, nothing queued
     std::string vehicle = rp.vehicle_id;
@@ -37,6 +42,11 @@ void MappingRos::Impl::startFleet(MapperRole role) {
                                 ") must be 0 for wavog_fleet: the fleet map has no robot to "
                                 "centre a window on");
   }
+  if (!rp.fleet_region.empty()) {
+    ROS_INFO("%s: region shard: integrating into [%g, %g] x [%g, %g] m only (fleet_region)",
+             pnh_.getNamespace().c_str(), rp.fleet_region[0], rp.fleet_region[2],
+             rp.fleet_region[1], rp.fleet_region[3]);
+  }
   // No tf input: an empty buffer keeps the shared paths (publication, flush) valid.
   buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(rp.tf_cache_time));
   fleet_ = std::make_unique<wavog_fleet::FleetReceiver>(
@@ -45,6 +55,10 @@ void MappingRos::Impl::startFleet(MapperRole role) {
         return integratePlacedLocked(pose, view);
       },
       updater_.get());
+  if (rp.fleet_window > 0.0) {
+    fleet_windows_ =
+        std::make_unique<wavog_fleet::VehicleWindows>(nh_, rp.fleet_vehicles, rp.fleet_window);
+  }
 }
 
 wavog::IntegrateStats MappingRos::Impl::integratePlacedLocked(const wavog::Pose2& pose,
@@ -60,10 +74,12 @@ wavog::IntegrateStats MappingRos::Impl::integratePlacedLocked(const wavog::Pose2
   if (st.status != wavog::ScanStatus::kOk) return st;
   changed_since_publish_ = true;
   const double res = map_.resolution();
-  publisher_->touched({static_cast<double>(st.touched.min_x) * res,
-                       static_cast<double>(st.touched.min_y) * res,
-                       static_cast<double>(st.touched.max_x) * res,
-                       static_cast<double>(st.touched.max_y) * res});
+  const MapBox box{static_cast<double>(st.touched.min_x) * res,
+                   static_cast<double>(st.touched.min_y) * res,
+                   static_cast<double>(st.touched.max_x) * res,
+                   static_cast<double>(st.touched.max_y) * res};
+  publisher_->touched(box);
+  if (fleet_windows_) fleet_windows_->touched(box);
   return st;
 }
 

@@ -43,6 +43,7 @@
 namespace wavog_fleet {
 class FleetStream;
 class FleetReceiver;
+class VehicleWindows;
 }  // namespace wavog_fleet
 
 namespace wavog_ros {
@@ -229,6 +230,7 @@ struct MappingRos::Impl {
 
   std::unique_ptr<wavog_fleet::FleetStream> fleet_stream_;  ///< null unless fleet_stream
   std::unique_ptr<wavog_fleet::FleetReceiver> fleet_;       ///< wavog_fleet only
+  std::unique_ptr<wavog_fleet::VehicleWindows> fleet_windows_;  ///< wavog_fleet, fleet_window > 0
 };
 
 }  // namespace wavog_ros

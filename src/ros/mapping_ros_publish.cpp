@@ -9,6 +9,7 @@
 #include <chrono>
 
 #include "fleet/fleet_receiver.h"
+#include "fleet/vehicle_windows.h"
 #include "mapping_ros_impl.h"
 
 namespace wavog_ros {
@@ -41,9 +42,15 @@ void MappingRos::Impl::publishAll() {
   const bool window_ok = windowCentre("maps not published", &cx, &cy);
 
   Layers layers;
+  std::vector<wavog_fleet::VehicleWindows::Window> windows;
   wavog_mapping::MapperStatus::Ptr status;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (fleet_windows_) {
+      windows = fleet_windows_->readLocked(map_, [this](std::size_t i, double* x, double* y) {
+        return fleet_->latestPositionLocked(i, x, y);
+      });
+    }
     if (window_ok) {
       layers = publisher_->read(map_, rp, cx, cy);
       changed_since_publish_ = false;
@@ -62,6 +69,7 @@ void MappingRos::Impl::publishAll() {
                        rp.base_frame.c_str());
   }
   MapPublisher::publish(layers, rp.map_frame, now);
+  wavog_fleet::VehicleWindows::publish(windows, rp.map_frame, now);
   status_pub_.publish(status);
   if (fleet_) fleet_->publishStatus(now);
   const double elapsed =
@@ -114,8 +122,16 @@ wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time&
 }
 
 void MappingRos::Impl::onUpdateTimer(const ros::TimerEvent&) {
-  if (!publisher_->updateWanted()) return;
   const ros::Time now = ros::Time::now();
+  if (fleet_windows_) {
+    std::vector<wavog_fleet::VehicleWindows::Window> updates;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      updates = fleet_windows_->readUpdatesLocked(map_);
+    }
+    wavog_fleet::VehicleWindows::publishUpdates(updates, config_.ros.map_frame, now);
+  }
+  if (!publisher_->updateWanted()) return;
   wavog::Raster raster;
   wavog::CellBox full;
   {

@@ -8,6 +8,7 @@
 #include <rosbag/bag.h>
 #include <sensor_msgs/LaserScan.h>
 #include <tf2_msgs/TFMessage.h>
+#include <wavog_mapping/PlacedScan.h>
 
 #include <cerrno>
 #include <cmath>
@@ -59,6 +60,7 @@ struct Options {
   // <prefix>k/...), on the route started k-1 / vehicles of a lap further (fleetMember).
   long vehicles = 1;
   std::string vehicle_prefix = "v";
+  bool placed_scans = false;  // write each vehicle's PlacedScan stream instead of scans and /tf
 };
 
 /// An angle option given in degrees, kept in radians (read whole, as addNumber).
@@ -129,6 +131,10 @@ void addOptions(CLI::App* app, Options* o) {
                           "over a lap; > 1: topics /<prefix>k/..., frames <prefix>k/...");
   app->add_option("--vehicle-prefix", o->vehicle_prefix, "namespace prefix of the fleet's vehicles")
       ->capture_default_str();
+  app->add_flag("--placed-scans", o->placed_scans,
+                "write each vehicle's stream of placed scans (/<ns>/fleet_scans, PlacedScan, at "
+                "the true sensor pose, as a mapper streams them) instead of its scans and /tf: "
+                "a fleet bag for wavog_fleet (make fleet-bench)");
   addPoseNoiseOptions(app, o);
 }
 
@@ -254,6 +260,35 @@ int run(const Options& o) {
     wavog::sim::ScanSimulator sim(w, o.seed + k);
     std::vector<std::size_t> per_laser(w.vehicle.lasers.size(), 0);
     SimScan scan;
+    std::uint64_t index = 0;
+    while (o.placed_scans && sim.next(&scan)) {
+      const LaserParams& laser = w.vehicle.lasers[static_cast<std::size_t>(scan.laser)];
+      wavog_mapping::PlacedScan m;
+      m.version = wavog_mapping::PlacedScan::FORMAT_VERSION;
+      m.header.stamp = t0 + ros::Duration(scan.stamp);
+      m.header.frame_id = map_frame;
+      m.vehicle = names[k].empty() ? "/" : "/" + names[k];
+      m.input = topic(names[k], laser.topic);
+      m.index = index++;
+      m.x = m.start_x = m.end_x = scan.sensor_pose.x;
+      m.y = m.start_y = m.end_y = scan.sensor_pose.y;
+      m.theta = m.start_theta = m.end_theta = scan.sensor_pose.theta;
+      const wavog::ScanView view = scan.view(laser);
+      m.angle_min = view.angle_min;
+      m.angle_increment = view.angle_increment;
+      m.range_min = view.range_min;
+      m.range_max = view.range_max;
+      m.period = 1.0 / laser.rate_hz;
+      m.ranges.assign(view.ranges, view.ranges + view.count);
+      bag.write(topic(names[k], "fleet_scans"), m.header.stamp, m);
+      ++per_laser[static_cast<std::size_t>(scan.laser)];
+      if (++done % 2000 == 0) std::cerr << "\rwavog_simulate: " << done << " placed scans";
+    }
+    if (o.placed_scans) {
+      summary << (summary.tellp() > 0 ? ", " : " ") << index << " on "
+              << topic(names[k], "fleet_scans");
+      continue;
+    }
     while (sim.next(&scan)) {
       const ros::Time stamp = t0 + ros::Duration(scan.stamp);
       tf2_msgs::TFMessage tf;

@@ -144,6 +144,35 @@ void BM_Integrate(benchmark::State& state, std::string wl, double res, Variant v
   state.counters["bytes_per_cell"] = f.bytes_per_cell;
 }
 
+// Region shards (MapParams::region, issue 36): a shard whose region the scans never reach (its
+// blocks 1000 blocks away) against the map of every block, on the same scans: the cost a shard
+// pays for a scan that misses its region, as a share of integrating it (target <= 5 %).
+std::map<std::string, std::vector<double>> g_region_us;  // key -> us per scan per repetition
+
+void BM_Region(benchmark::State& state, std::string wl, double res, Variant v, bool miss) {
+  const auto& scans = workload(wl);
+  if (scans.empty()) {
+    state.SkipWithError("data set not found (../shared/data or WAVOG_DATA_DIR)");
+    return;
+  }
+  MapParams p = paramsFor(v, res, 0.0);
+  if (miss) {
+    p.region.all = false;
+    p.region.min_bx = p.region.min_by = 1000;
+    p.region.max_bx = p.region.max_by = 1001;
+  }
+  const std::string key = wl + "@" + std::to_string(static_cast<int>(std::lround(res * 100))) +
+                          "cm/" + kVariantNames[v] + (miss ? "/miss" : "/all");
+  for (auto _ : state) {
+    wavog::WaveletMap map(p);
+    const double t0 = threadCpuSeconds();
+    for (const auto& s : scans) benchmark::DoNotOptimize(map.integrate(s.pose, s.view()));
+    const double secs = threadCpuSeconds() - t0;
+    state.SetIterationTime(secs);
+    g_region_us[key].push_back(1e6 * secs / static_cast<double>(scans.size()));
+  }
+}
+
 // Parallel integration (num_threads): wall-clock time, since the work is on several threads.
 // `levels`: block_levels, which sets the blocks per scan (the unit of work shared out).
 std::map<std::string, std::vector<double>> g_wall;  // key -> scans/s per repetition
@@ -261,6 +290,20 @@ void printSummary() {
                 median(g_wall[one]), median(g_wall[two]), median(g_wall[two]) / median(g_wall[one]),
                 g_blocks_per_scan[one], target.c_str());
   }
+  bool any_region = false;
+  for (const auto& kv : g_region_us) {
+    const std::string k = kv.first;
+    if (k.size() < 5 || k.substr(k.size() - 5) != "/miss") continue;
+    const std::string all = k.substr(0, k.size() - 5) + "/all";
+    if (!g_region_us.count(all)) continue;
+    if (!any_region) {
+      std::printf("\n== Region shards: a scan that misses the shard's region ==\n");
+      any_region = true;
+    }
+    const double miss_us = median(kv.second), all_us = median(g_region_us[all]);
+    std::printf("%-32s %8.2f us per missed scan, %8.1f us integrated: %.1f %% (target <= 5 %%)\n",
+                all.substr(0, all.size() - 4).c_str(), miss_us, all_us, 100.0 * miss_us / all_us);
+  }
   // Memory and pruning error on fr079 at 5 cm with forgetting, tau = 0, 0.01, 0.05.
   if (!g_rates.count("fr079@5cm/forget_lazy")) return;  // only with the fr079 5 cm runs
   const auto& scans = workload("fr079");
@@ -307,6 +350,18 @@ int main(int argc, char** argv) {
             ->Repetitions(5)
             ->ReportAggregatesOnly(true);
       }
+    }
+  }
+  for (const char* wl : {"fr079", "synthetic80m"}) {
+    for (bool miss : {false, true}) {
+      const std::string name = std::string("region/") + wl + "/5cm/forget_lazy/" +
+                               (miss ? "miss" : "all");
+      benchmark::RegisterBenchmark(name.c_str(), BM_Region, std::string(wl), 0.05, kForgetLazy, miss)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond)
+          ->Iterations(1)
+          ->Repetitions(5)
+          ->ReportAggregatesOnly(true);
     }
   }
   // Interleaved with the others by --benchmark_enable_random_interleaving (make bench), so the

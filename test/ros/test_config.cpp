@@ -153,6 +153,43 @@ TEST(Config, ReadsTheNdtKeys) {
             std::string::npos);
 }
 
+TEST(Config, FleetRegionIsTheCoresBlockRegionOrAClearError) {
+  EXPECT_TRUE(fromYaml("{}").map.region.all);  // everything by default
+  // Blocks of 0.1 m x 2^4 = 1.6 m.
+  const Config c = fromYaml("{resolution: 0.1, block_levels: 4, fleet_region: [-3.2, 0, 4.8, 16]}");
+  EXPECT_FALSE(c.map.region.all);
+  EXPECT_EQ(c.map.region.min_bx, -2);
+  EXPECT_EQ(c.map.region.min_by, 0);
+  EXPECT_EQ(c.map.region.max_bx, 3);
+  EXPECT_EQ(c.map.region.max_by, 10);
+  const std::string form = "fleet_region must be [] (everything) or [min_x, min_y, max_x, max_y]";
+  const std::string unaligned =
+      errorOf("{resolution: 0.1, block_levels: 4, fleet_region: [-3.2, 0, 5, 16]}");
+  EXPECT_NE(unaligned.find(form), std::string::npos) << unaligned;
+  EXPECT_NE(unaligned.find("1.6 m"), std::string::npos) << unaligned;
+  EXPECT_NE(unaligned.find("5 is not a multiple"), std::string::npos) << unaligned;
+  EXPECT_NE(errorOf("{resolution: 0.1, block_levels: 4, fleet_region: [0, 0, 1.6]}").find(form),
+            std::string::npos);
+  EXPECT_NE(errorOf("{resolution: 0.1, block_levels: 4, fleet_region: [3.2, 0, 1.6, 1.6]}")
+                .find("min must be below max"),
+            std::string::npos);
+  EXPECT_NE(errorOf("{fleet_region: [0, 0, .nan, 1]}").find("fleet_region"), std::string::npos);
+  EXPECT_NE(errorOf("{fleet_region: 3}").find("'fleet_region'"), std::string::npos);
+  // Beyond the extent: the core's rule names it.
+  EXPECT_NE(errorOf("{resolution: 1, block_levels: 2, fleet_region: [0, 0, 4e9, 4]}").find("region"),
+            std::string::npos);
+}
+
+TEST(Config, FleetWindowIsBoundedByTheLayerLimit) {
+  EXPECT_EQ(fromYaml("{}").ros.fleet_window, 0.0);  // off by default
+  EXPECT_EQ(fromYaml("{fleet_window: 25}").ros.fleet_window, 25.0);
+  // 4094 cells of 5 cm / 2: 102.35 m.
+  EXPECT_NE(errorOf("{fleet_window: 103}").find("fleet_window (103) must be in [0, 102.35] m"),
+            std::string::npos)
+      << errorOf("{fleet_window: 103}");
+  EXPECT_NE(errorOf("{fleet_window: -1}").find("fleet_window"), std::string::npos);
+}
+
 TEST(Config, ReportsUnknownKeys) {
   std::vector<std::string> unknown;
   fromYaml("{resolutoin: 0.1, publish_rate: 2}", &unknown);

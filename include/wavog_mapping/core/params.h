@@ -4,6 +4,7 @@
 #ifndef WAVOG_MAPPING_CORE_PARAMS_H_
 #define WAVOG_MAPPING_CORE_PARAMS_H_
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,22 @@ struct PolicyParams {
   InitValue init = InitValue::kUnknown;
 };
 
+/// The blocks a map integrates into (a region shard of a fleet, docs/fleet.md): block (bx, by)
+/// covers the finest cells [bx 2^block_levels, (bx + 1) 2^block_levels) x [by ..., ...); the
+/// region holds min_bx <= bx < max_bx, min_by <= by < max_by. A scan still integrates exactly as
+/// in a map of every block, but only into these blocks; one that reaches none of them costs its
+/// preparation only. Every cell of a block depends only on the scans that reach that block, so
+/// maps of disjoint regions fed the same scans hold, together, the cells of one map of all.
+struct BlockRegion {
+  bool all = true;  ///< every block (the default); the bounds below are then unused
+  /// Block indices, min < max on each axis, inside the extent (limits.h): |bx| and |by| at most
+  /// kCellIndexLimit >> block_levels.
+  std::int64_t min_bx = 0, min_by = 0, max_bx = 0, max_by = 0;
+  bool contains(std::int64_t bx, std::int64_t by) const {
+    return all || (bx >= min_bx && bx < max_bx && by >= min_by && by < max_by);
+  }
+};
+
 /// Everything a map needs.
 struct MapParams {
   GridParams grid;
@@ -141,6 +158,8 @@ struct MapParams {
   double ndt_min_weight = 0.01;
   /// ndt with "clamp" / "clamp_upper": the largest weight of a cell, in [1, 1e9].
   double ndt_max_weight = 100.0;
+  /// The blocks this map integrates into (default: all). Kept by setPolicy().
+  BlockRegion region;
 
   /// Every violated rule, one line each, naming the parameter and its valid range. Empty: valid.
   std::vector<std::string> validate() const;

@@ -38,8 +38,12 @@ struct IntegrateStats {
   std::uint64_t nodes_visited = 0;   ///< tree nodes and finest cells visited
   std::uint32_t blocks_touched = 0;  ///< blocks classified as not U
   /// Finest cells within the scan's reach (the farthest E or O limit of its beams): every cell
-  /// the scan changed lies in this box. Empty when status != kOk.
+  /// the scan changed lies in this box. Empty when status != kOk. With MapParams::region: clipped
+  /// to the region's cells, empty when the scan reaches none of its blocks.
   CellBox touched;
+  /// MapParams::region only: the scan (status kOk) reached none of the region's blocks, so
+  /// nothing was walked or changed (its beams may then be left uncounted above).
+  bool outside_region = false;
 };
 
 /// Size and work figures of a map.

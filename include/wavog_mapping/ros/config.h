@@ -98,6 +98,15 @@ struct RosParams {
   /// aware) is refused (dropped_bad_stamp), in (0, 86400]: one far-future stamp would otherwise
   /// make every later scan late. Covers clock skew, the mappers' tf wait and the stream's delay.
   double fleet_max_stamp_offset = 60.0;
+  /// Fleet node: the region this node (a region shard) maps, [min_x, min_y, max_x, max_y] (m, map
+  /// frame), each a multiple of the block size (resolution x 2^block_levels), min < max; it
+  /// integrates every vehicle's scans into the blocks of this rectangle only (MapParams::region).
+  /// Empty: everything (one fleet node for the site).
+  std::vector<double> fleet_region;
+  /// Fleet node: half-width (m) of the square around each vehicle's latest streamed position in
+  /// which it publishes its finest layer back to the vehicle (<ns>/fleet_map, _updates); 0: off.
+  /// At most the half-width whose window holds kMaxLayerCells cells.
+  double fleet_window = 0.0;
 };
 
 /// Most vehicles one fleet node follows.
@@ -134,6 +143,11 @@ XmlRpc::XmlRpcValue yamlToXmlRpc(const std::string& yaml_text);
 /// Aggregation <-> configuration name ("mean", "max").
 const char* toString(wavog::Aggregation aggregation);
 bool fromString(const std::string& name, wavog::Aggregation* aggregation);
+
+/// fleet_region (m) as the blocks of a map of `grid` (`region` must hold 4 values): false, with
+/// *why, when they are not finite, min < max and multiples of the block size.
+bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParams& grid,
+                       wavog::BlockRegion* out, std::string* why);
 
 /// Every violation of the ROS parameters (given the core parameters), one line each.
 std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& map);

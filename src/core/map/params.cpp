@@ -4,6 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/types.h"
 
 namespace wavog {
@@ -108,6 +109,19 @@ std::vector<std::string> MapParams::validate() const {
         ndt_min_weight, "in [0, 1e6] (end-points)", &v);
   check(finite(ndt_max_weight) && ndt_max_weight >= 1.0 && ndt_max_weight <= 1e9, "ndt_max_weight",
         ndt_max_weight, "in [1, 1e9] (end-points)", &v);
+  if (!region.all && grid.block_levels >= 2 && grid.block_levels <= 12) {
+    const std::int64_t lim = kCellIndexLimit >> grid.block_levels;
+    const auto inside = [lim](std::int64_t b) { return b >= -lim && b <= lim; };
+    if (!(region.min_bx < region.max_bx && region.min_by < region.max_by && inside(region.min_bx) &&
+          inside(region.max_bx) && inside(region.min_by) && inside(region.max_by))) {
+      std::ostringstream s;
+      s << "region (blocks [" << region.min_bx << ", " << region.max_bx << ") x ["
+        << region.min_by << ", " << region.max_by
+        << ")) must be a non-empty box of blocks, min < max on each axis, within +-" << lim
+        << " blocks (the extent)";
+      v.push_back(s.str());
+    }
+  }
   // clamp_min < clamp_max needs no rule of its own: the two rules above force their signs.
   return v;
 }

@@ -36,6 +36,8 @@ struct FleetReceiver::Vehicle {
   double lag_max_period = 0.0;
   ros::Time oldest_unpublished;  ///< stamp of the oldest scan integrated since the last layers
   double publish_lag_max_period = 0.0;
+  bool has_position = false;  ///< x, y: the latest integrated scan's sensor position
+  double x = 0.0, y = 0.0;
 };
 
 FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
@@ -167,6 +169,11 @@ void FleetReceiver::integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan&
     return;
   }
   ++c.integrated;
+  if (st.outside_region) c.outside_region = saturatingAdd(c.outside_region, 1);
+  c.in_region = !st.outside_region;
+  v->has_position = true;
+  v->x = m.x;
+  v->y = m.y;
   if (integrated_stamp_ < m.header.stamp) integrated_stamp_ = m.header.stamp;
   // In double seconds: ros::Time's operator- throws beyond 2^31 s (the stamp passed
   // fleet_max_stamp_offset, but the clock may have jumped since).
@@ -185,6 +192,13 @@ void FleetReceiver::layersPublishedLocked(const ros::Time& now) {
         std::max(v->publish_lag_max_period, wavog_ros::secondsBetween(now, v->oldest_unpublished));
     v->oldest_unpublished = ros::Time();
   }
+}
+
+bool FleetReceiver::latestPositionLocked(std::size_t i, double* x, double* y) const {
+  if (i >= vehicles_.size() || !vehicles_[i]->has_position) return false;
+  *x = vehicles_[i]->x;
+  *y = vehicles_[i]->y;
+  return true;
 }
 
 std::uint64_t FleetReceiver::integratedLocked() const {
@@ -246,6 +260,7 @@ void FleetReceiver::diagnose(const Vehicle* v, diagnostic_updater::DiagnosticSta
   stat.add("integrated", c.integrated);
   stat.add("integrated late", c.integrated_late);
   stat.add("lost", c.lost);
+  stat.add("outside region", c.outside_region);
   stat.add("index regressions", c.index_regressions);
   stat.add("index jumps", c.index_jumps);
   stat.add("dropped late", c.dropped_late);

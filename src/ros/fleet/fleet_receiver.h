@@ -41,6 +41,9 @@ class FleetReceiver {
                 double resolution, std::mutex* mutex, IntegrateFn integrate, diagnostic_updater::Updater* updater);
   ~FleetReceiver();
 
+  /// The sensor position (map frame, m) of vehicle i's latest integrated scan, i in the order of
+  /// fleet_vehicles; false when none yet (under the mapper's lock).
+  bool latestPositionLocked(std::size_t i, double* x, double* y) const;
   /// Scans integrated, all vehicles (under the mapper's lock).
   std::uint64_t integratedLocked() const;
   /// The map layers were just read for publication at `now` (under the mapper's lock): every
