@@ -4,8 +4,9 @@
 // (resolution onwards), framed with the magic, version and a valid CRC-32, so that mutations
 // reach the parser behind the checksum; clear: the rest is the file as it is. Bits 1-2: the
 // loading map's policy (clamp, or forgetting with one of three gammas, so a file's pending
-// forgetting tags are sometimes applied while loading). Bits 3 and 6: the framed version, 5
-// (neither; 4, unbounded clamp counts, with the clamp policy and bit 4), 1 (bit 3: u8 pending
+// forgetting tags are sometimes applied while loading). Bits 3 and 6: the framed version, 5 and
+// then the same content as 6, the current one (neither: loaded twice, f32 then f64 details;
+// 4, unbounded clamp counts, with the clamp policy and bit 4), 1 (bit 3: u8 pending
 // counts), 2 (bit 6: no NDT section) or 3 (both: no hits section). Bit 4: forgetting with
 // forget_half_life (16-bit pending units). Bit 5: the loading
 // map keeps normal-distribution cells (MapParams::ndt). Bit 7: it keeps a reflection map
@@ -75,14 +76,8 @@ MapParams paramsFor(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
   return p;
 }
 
-}  // namespace
-
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  if (size < 1) return 0;
-  const std::uint8_t mode = data[0];
-  const std::vector<std::uint8_t> file = (mode & 1)
-                                             ? frame(data + 1, size - 1, framedVersion(mode))
-                                             : std::vector<std::uint8_t>(data + 1, data + size);
+// One file through the loader and the oracles.
+void loadAndCheck(const std::vector<std::uint8_t>& file, std::uint8_t mode) {
   const MapParams params = paramsFor(file, mode);
   static const std::string path = wavog_fuzz::scratchPath("load.wavog");
   static const std::string again_path = wavog_fuzz::scratchPath("again.wavog");
@@ -94,7 +89,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const wavog::MapIoError&) {
     // Refused, with a message: the map must be left as it was (empty).
     WAVOG_FUZZ_CHECK(map.stats().blocks == 0, "a refused load changed the map");
-    return 0;
+    return;
   }
   const auto rasters = wavog_fuzz::readOutEveryScale(map);
   const auto payloads = wavog_fuzz::readPayloads(map);
@@ -137,5 +132,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)wavog_fuzz::readPayloads(map);
     map.save(again_path);
   }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  const std::uint8_t mode = data[0];
+  if (!(mode & 1)) {
+    loadAndCheck(std::vector<std::uint8_t>(data + 1, data + size), mode);
+    return 0;
+  }
+  const std::uint32_t version = framedVersion(mode);
+  loadAndCheck(frame(data + 1, size - 1, version), mode);
+  // Version 5 differs from the current 6 only in the width of the details: the same content is
+  // a hostile version-6 file too (a file of blocks without subtrees loads as both).
+  if (version == 5) loadAndCheck(frame(data + 1, size - 1, 6), mode);
   return 0;
 }
