@@ -72,6 +72,10 @@ class ScanClassifier {
   CellClass cellAt(std::size_t j, double d2) const;
   bool isHitCell(std::int64_t ix, std::int64_t iy, const SquareInfo& box) const;
   std::uint32_t hitMask4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const;
+  bool quadrantBuckets(const std::array<double, 4>& dx, const std::array<double, 4>& dy,
+                       const std::array<double, 4>& cx, const std::array<double, 4>& sx,
+                       const std::array<double, 4>& cy, const std::array<double, 4>& sy,
+                       std::uint32_t* bucket) const;
   long beamOf(double dx, double dy) const;
   long sectorIn(double dx, double dy, const SquareInfo& box, int start) const;
   int lastSurelyPast(double dx, double dy, double tol, int lo, int hi) const;
