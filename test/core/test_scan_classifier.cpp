@@ -193,13 +193,13 @@ TEST(SectorTable, SureBucketsGiveTheReferenceBeam) {
     double amin, inc;
   };
   const double pi = 3.14159265358979323846;
-  const Geometry geometries[] = {{361, -pi / 2, pi / 360},        // LMS-291, 180 deg
-                                 {360, -pi / 2, pi / 360},        // fr079
-                                 {1081, -2.35619449, 0.00436332}, // 270 deg
-                                 {720, -pi, 2 * pi / 720},        // a whole turn
-                                 {720, -pi, 2 * pi / 720 + 1e-9}, // slightly more than a turn
-                                 {16, 1.0, 0.2},                  // coarse
-                                 {5, 7.5, 0.01}};                 // angle_min beyond 2 pi
+  const Geometry geometries[] = {{361, -pi / 2, pi / 360},         // LMS-291, 180 deg
+                                 {360, -pi / 2, pi / 360},         // fr079
+                                 {1081, -2.35619449, 0.00436332},  // 270 deg
+                                 {720, -pi, 2 * pi / 720},         // a whole turn
+                                 {720, -pi, 2 * pi / 720 + 1e-9},  // slightly more than a turn
+                                 {16, 1.0, 0.2},                   // coarse
+                                 {5, 7.5, 0.01}};                  // angle_min beyond 2 pi
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> angle(-pi, pi), unit(0.0, 1.0);
   for (const Geometry& g : geometries) {
@@ -233,6 +233,49 @@ TEST(SectorTable, SureBucketsGiveTheReferenceBeam) {
     // Of the directions drawn anywhere, at most a sixth are unsure (near a boundary).
     EXPECT_GT(static_cast<double>(sure), 0.83 * static_cast<double>(count)) << "n " << g.n;
   }
+}
+
+// The endpoints of hit beams come from unit vectors rotated by the pose, a few ulps from the
+// reference's cos / sin of theta + bearing: an endpoint that lands on a cell edge must still get
+// the reference's cell. Poses are placed so that the reference's endpoint is within ulps of an
+// edge, where the rotated arithmetic alone picks the other cell now and then (counted).
+TEST(PreparedScan, HitCellsAreTheReferencesAtCellEdges) {
+  wavog::MapParams params = wavog::MapParams::defaultsFor(wavog::PolicyType::kClamp);
+  params.grid.resolution = 0.0625;  // a power of two: ex / res is exact
+  const double res = params.grid.resolution;
+  std::mt19937 rng(34);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::size_t differ = 0, checked = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double theta = -3.0 + 6.0 * unit(rng), amin = -1.5 + 3.0 * unit(rng);
+    const float range = static_cast<float>(1.0 + 30.0 * unit(rng));
+    const double z = range;
+    const double bearing = theta + (amin + 0.0 * 0.01);
+    const double ref_c = std::cos(bearing);
+    const double rot_c = std::cos(theta) * std::cos(amin) - std::sin(theta) * std::sin(amin);
+    const double k = std::floor(100.0 * unit(rng));
+    double px = k * res - z * ref_c;
+    for (int step = 0; step < 8; ++step, px = std::nextafter(px, 1e9)) {
+      const double ref_x = std::floor((px + z * ref_c) / res);
+      if (ref_x == std::floor((px + z * rot_c) / res)) continue;
+      ++differ;
+      wavog::ScanView view;
+      view.ranges = &range;
+      view.count = 1;
+      view.angle_min = amin;
+      view.angle_increment = 0.01;
+      view.range_min = 0.0;
+      view.range_max = 100.0;
+      wavog::detail::PreparedScan ps;
+      wavog::IntegrateStats st;
+      ASSERT_EQ(ps.prepare(params, wavog::Pose2{px, 0.3, theta}, view, &st),
+                wavog::ScanStatus::kOk);
+      EXPECT_EQ(ps.hit_x[0], static_cast<std::int64_t>(ref_x)) << "trial " << trial;
+      ++checked;
+    }
+  }
+  EXPECT_GT(differ, 10u);  // the rotated arithmetic alone would have missed these cells
+  EXPECT_EQ(checked, differ);
 }
 
 }  // namespace

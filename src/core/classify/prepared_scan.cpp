@@ -51,6 +51,8 @@ ScanStatus PreparedScan::prepare(const MapParams& params, const Pose2& pose, con
   setGeometry(pose, scan, cell);
   setBoundaries();
   sectors.prepare(n, amin, inc);
+  setUnits();
+  exact_ends_ = params.ndt;  // the Gaussians take the endpoints as the reference computes them
   setBeams(limits, scan, st);
   if (invalid_prefix[static_cast<std::size_t>(n)] == n) return ScanStatus::kNoValidBeam;
   std::sort(hits.begin(), hits.end());
@@ -131,7 +133,7 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
   const double clear = limits.clear;
   const double inf = std::numeric_limits<double>::infinity();
   kind.assign(nu, BeamKind::kInvalid);
-  leaf.resize(nu + 1);  // every element is written below
+  leaf.resize(nu + 1);    // every element is written below
   leaf[nu] = LeafTest{};  // outside the fan: never E, never O
   // Level 0 of the tables is written below, the levels above by buildTables(). Sized once per
   // scan without clearing (a resize to the same size touches nothing).
@@ -147,6 +149,12 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
   end_x.resize(nu);  // written for the hit beams below
   end_y.resize(nu);
   reach = 0.0;
+  // The rotated endpoint differs from the reference's by under 2^-53 (|theta| + |bearing|) z for
+  // the rounding of theta + bearing plus a few ulps of |p| + z (cos, sin, products; 1e-15 each
+  // bounds them): a guard of 1e-12 of those, in cells, around a cell edge leaves a 1000-fold
+  // margin.
+  const double angle_scale = std::fabs(theta) + std::fabs(amin) + 8.0;
+  const double end_offset = std::fabs(px) + std::fabs(py);
   for (std::size_t j = 0; j < nu; ++j) {
     const double z = ranges_[j];
     double ze = inf, zu = -inf;  // E limit and end of the occupied band (m)
@@ -164,12 +172,26 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
       kind[j] = BeamKind::kHit;
       ze = z - half_band;
       zu = z + half_band;
-      const double bearing = theta + (amin + static_cast<double>(j) * inc);
-      const double ex = px + z * std::cos(bearing), ey = py + z * std::sin(bearing);
+      // The endpoint from the beam's unit vector rotated by the pose (a few ulps from the
+      // reference's cos / sin of theta + bearing); the reference's own arithmetic when its
+      // cell could differ, or when the endpoint itself is used (exact_ends_).
+      double ex = px + z * (cos_theta * unit_c_[j] - sin_theta * unit_s_[j]);
+      double ey = py + z * (sin_theta * unit_c_[j] + cos_theta * unit_s_[j]);
+      double ux = ex / res, uy = ey / res;
+      double fx = fastFloor(ux), fy = fastFloor(uy);
+      const double guard = 1e-12 * (1.0 + (end_offset + z + z * angle_scale) / res);
+      if (exact_ends_ || !(ux - fx > guard) || !(fx + 1.0 - ux > guard) || !(uy - fy > guard) ||
+          !(fy + 1.0 - uy > guard)) {
+        const double bearing = theta + (amin + static_cast<double>(j) * inc);
+        ex = px + z * std::cos(bearing);
+        ey = py + z * std::sin(bearing);
+        fx = std::floor(ex / res);
+        fy = std::floor(ey / res);
+      }
       end_x[j] = ex;
       end_y[j] = ey;
-      hit_x[j] = static_cast<std::int64_t>(std::floor(ex / res));
-      hit_y[j] = static_cast<std::int64_t>(std::floor(ey / res));
+      hit_x[j] = static_cast<std::int64_t>(fx);
+      hit_y[j] = static_cast<std::int64_t>(fy);
       hits.push_back(cellKey(hit_x[j], hit_y[j]));
       hit_group[j] = groupKey(hit_x[j], hit_y[j]);
       hit_bit[j] = 1u << ((hit_x[j] & 3) + 4 * (hit_y[j] & 3));
@@ -182,6 +204,21 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
     if (valid) reach = std::max(reach, zu);
     invalid_prefix[j + 1] = invalid_prefix[j] + (valid ? 0 : 1);
   }
+}
+
+void PreparedScan::setUnits() {
+  if (n == units_n_ && amin == units_amin_ && inc == units_inc_) return;
+  const auto nu = static_cast<std::size_t>(n);
+  unit_c_.resize(nu);
+  unit_s_.resize(nu);
+  for (std::size_t j = 0; j < nu; ++j) {
+    const double a = amin + static_cast<double>(j) * inc;
+    unit_c_[j] = std::cos(a);
+    unit_s_[j] = std::sin(a);
+  }
+  units_n_ = n;
+  units_amin_ = amin;
+  units_inc_ = inc;
 }
 
 int PreparedScan::tableLevels() {
@@ -212,6 +249,9 @@ void PreparedScan::releaseIfLarge() {
   if (ranges_.capacity() <= kScratchKeepBeams) return;
   const auto release = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
   release(ranges_);
+  release(unit_c_);
+  release(unit_s_);
+  units_n_ = -1;
   release(kind);
   release(leaf);
   release(hit_x);

@@ -48,13 +48,13 @@ struct PreparedScan {
   int n = 0;                         ///< beams
   double reach = 0;                  ///< largest U limit over the valid beams (m)
   // Bearing constants of the fast beam lookup.
-  double seam_map = 0;    ///< theta + seam reduced to [-pi, pi): the seam, map frame
-  double inv_inc = 0;     ///< 1 / inc
-  double t_seam = 0;      ///< (seam - amin) / inc
-  double fast_guard = 0;  ///< |t - (j + 1/2)| beyond which fastAtan2 gives lround(t)
+  double seam_map = 0;                  ///< theta + seam reduced to [-pi, pi): the seam, map frame
+  double inv_inc = 0;                   ///< 1 / inc
+  double t_seam = 0;                    ///< (seam - amin) / inc
+  double fast_guard = 0;                ///< |t - (j + 1/2)| beyond which fastAtan2 gives lround(t)
   double cos_theta = 1, sin_theta = 0;  ///< rotate map-frame offsets into the sensor frame
 
-  std::vector<BeamKind> kind;              ///< per beam
+  std::vector<BeamKind> kind;  ///< per beam
   std::vector<LeafTest> leaf;  ///< per beam: exact leaf thresholds; leaf[n]: outside (never E, O)
   std::vector<std::int64_t> hit_x, hit_y;  ///< per beam: the cell of its endpoint (hit beams)
   std::vector<double> end_x, end_y;        ///< per beam: its endpoint, map frame (hit beams)
@@ -140,10 +140,16 @@ struct PreparedScan {
   };
   static BeamLimits beamLimits(const MapParams& params, const ScanView& scan);
   void setBeams(const BeamLimits& limits, const ScanView& scan, IntegrateStats* st);
+  /// The beams' sensor-frame unit vectors, kept while the geometry (n, amin, inc) is.
+  void setUnits();
   void buildTables();
   int tableLevels();  // sizes the tables for n beams; returns their levels
 
-  std::vector<float> ranges_;  // work copy, in ascending bearing order
+  std::vector<float> ranges_;            // work copy, in ascending bearing order
+  std::vector<double> unit_c_, unit_s_;  // cos / sin of amin + j inc
+  int units_n_ = -1;                     // the geometry they hold
+  double units_amin_ = 0, units_inc_ = 0;
+  bool exact_ends_ = false;  // endpoints by the reference's cos / sin for every hit (NDT)
 };
 
 }  // namespace detail

@@ -72,6 +72,8 @@ class ScanClassifier {
   CellClass cellAt(std::size_t j, double d2) const;
   bool isHitCell(std::int64_t ix, std::int64_t iy, const SquareInfo& box) const;
   std::uint32_t hitMask4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const;
+  bool quadrantBuckets(const std::array<double, 4>& dx, const std::array<double, 4>& dy,
+                       std::uint32_t* bucket) const;
   long beamOf(double dx, double dy) const;
   long sectorIn(double dx, double dy, const SquareInfo& box, int start) const;
   int lastSurelyPast(double dx, double dy, double tol, int lo, int hi) const;
@@ -86,8 +88,15 @@ class ScanClassifier {
   CellClass rangeClass(const Square& sq, int jlo, int jhi, bool partial) const;
   CellClass classifyInBeam(int l, std::int64_t ix0, std::int64_t iy0, int j) const;
 
+  /// quadrantBuckets()' coefficients for one sign pair: D = dx * (cell dx) + dy * (cell dy),
+  /// the numerator nx * (cell dx) + ny * (cell dy) (map-frame offsets).
+  struct QuadrantCoeffs {
+    double dx = 0, dy = 0, nx = 0, ny = 0;
+  };
+
   PreparedScan s_;
-  double reach2_ = 0;  // squaredLimit(s_.reach)
+  double reach2_ = 0;                         // squaredLimit(s_.reach)
+  std::array<QuadrantCoeffs, 4> quadrant_{};  // by sign pair: bit 0 X < 0, bit 1 Y < 0
 };
 
 }  // namespace detail

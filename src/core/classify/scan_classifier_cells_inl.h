@@ -14,6 +14,18 @@ inline ScanStatus ScanClassifier::prepare(const MapParams& params, const Pose2& 
                                           const ScanView& scan, IntegrateStats* st) {
   const ScanStatus status = s_.prepare(params, pose, scan, st);
   reach2_ = squaredLimit(s_.reach);
+  // quadrantBuckets(): per sign pair (a, b) of the sensor-frame offset, D = aX + bY and the
+  // numerator as multiples of the map-frame dx and dy.
+  const double c = s_.cos_theta, sn = s_.sin_theta, scale = s_.sectors.scale();
+  for (std::size_t q = 0; q < 4; ++q) {
+    const double a = (q & 1) ? -1.0 : 1.0, b = (q & 2) ? -1.0 : 1.0;
+    const double nb = (3.0 + a) * scale, ny = a * scale;  // exact: scale is a power of two
+    QuadrantCoeffs& k = quadrant_[q];
+    k.dx = a * c - b * sn;
+    k.dy = a * sn + b * c;
+    k.nx = nb * k.dx - ny * sn;
+    k.ny = nb * k.dy + ny * c;
+  }
   return status;
 }
 
@@ -81,10 +93,13 @@ inline bool ScanClassifier::isHitCell(std::int64_t ix, std::int64_t iy,
 inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
                                              const SquareInfo& box) const {
   // The reference's arithmetic: dx = (ix + 1/2) res - px, d2 = dx dx + dy dy.
+  // (x0 + i) + 1/2 = x0 + (i + 1/2) exactly (cell indices are far below 2^51): one conversion.
+  const double x0 = static_cast<double>(ix0), y0 = static_cast<double>(iy0);
   std::array<double, 4> dx, dy, dx2, dy2;
   for (std::size_t i = 0; i < 4; ++i) {
-    dx[i] = (static_cast<double>(ix0 + static_cast<std::int64_t>(i)) + 0.5) * s_.res - s_.px;
-    dy[i] = (static_cast<double>(iy0 + static_cast<std::int64_t>(i)) + 0.5) * s_.res - s_.py;
+    const double half = static_cast<double>(i) + 0.5;
+    dx[i] = (x0 + half) * s_.res - s_.px;
+    dy[i] = (y0 + half) * s_.res - s_.py;
     dx2[i] = dx[i] * dx[i];
     dy2[i] = dy[i] * dy[i];
   }
@@ -103,19 +118,21 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
     m.o = (o & ~e) | hit;
     return m;
   }
-  // Each cell's sector (n: outside the fan) from its bucket, or kUnsure. The sensor-frame
-  // offsets are separable too.
-  std::array<double, 4> cx, sx, cy, sy;
-  for (std::size_t i = 0; i < 4; ++i) {
-    cx[i] = s_.cos_theta * dx[i];
-    sx[i] = s_.sin_theta * dx[i];
-    cy[i] = s_.cos_theta * dy[i];
-    sy[i] = s_.sin_theta * dy[i];
-  }
+  // Each cell's sector (n: outside the fan) from its bucket, or kUnsure.
   const SectorTable& table = s_.sectors;
   std::array<std::uint32_t, 16> bucket;
-  for (std::size_t i = 0; i < 16; ++i) {
-    bucket[i] = table.bucket(cx[i & 3] + sy[i >> 2], cy[i >> 2] - sx[i & 3]);
+  if (!quadrantBuckets(dx, dy, bucket.data())) {
+    // The sensor-frame offsets are separable too.
+    std::array<double, 4> cx, sx, cy, sy;
+    for (std::size_t i = 0; i < 4; ++i) {
+      cx[i] = s_.cos_theta * dx[i];
+      sx[i] = s_.sin_theta * dx[i];
+      cy[i] = s_.cos_theta * dy[i];
+      sy[i] = s_.sin_theta * dy[i];
+    }
+    for (std::size_t i = 0; i < 16; ++i) {
+      bucket[i] = table.bucket(cx[i & 3] + sy[i >> 2], cy[i >> 2] - sx[i & 3]);
+    }
   }
   std::array<std::int32_t, 16> sector;
   const std::int32_t* sectors = table.data();
@@ -140,6 +157,45 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
   m.e = e & ~hit;
   m.o = (o & ~e) | hit;
   return m;
+}
+
+/// The table buckets of the 16 cells of a 4 x 4 group whose sensor-frame offsets
+/// (X, Y) = (c dx + s dy, c dy - s dx) keep their signs a, b over the group, if they do (else
+/// false). There the pseudo-bearing times the table's scale is ((3 + a) scale D + a scale Y) / D
+/// with D = |X| + |Y| = aX + bY: numerator and denominator are a multiple of dx plus a multiple
+/// of dy (coefficients per scan and sign pair), so a cell costs two additions, a division and a
+/// conversion, without selects (vectorised). X and Y are linear over the group, so their extremes
+/// over it are sums of the extremes of their dx and dy terms; a group within 1e-12 (|dx| + |dy|)
+/// of an axis (far above the rounding of X and Y) is left to SectorTable::bucket. The quotient
+/// differs from pseudoBearing() scale by under 1e-13 scale (a few ulps on terms of at most
+/// 7 scale |d|, over D >= |d|), far inside the table's margin, which its sure buckets allow for.
+inline bool ScanClassifier::quadrantBuckets(const std::array<double, 4>& dx,
+                                            const std::array<double, 4>& dy,
+                                            std::uint32_t* bucket) const {
+  const double c = s_.cos_theta, sn = s_.sin_theta;
+  const double cx0 = c * dx[0], cx3 = c * dx[3], sx0 = sn * dx[0], sx3 = sn * dx[3];
+  const double cy0 = c * dy[0], cy3 = c * dy[3], sy0 = sn * dy[0], sy3 = sn * dy[3];
+  const double x_lo = std::min(cx0, cx3) + std::min(sy0, sy3);
+  const double x_hi = std::max(cx0, cx3) + std::max(sy0, sy3);
+  const double y_lo = std::min(cy0, cy3) - std::max(sx0, sx3);
+  const double y_hi = std::max(cy0, cy3) - std::min(sx0, sx3);
+  const double tiny = 1e-12 * (std::max(std::fabs(dx[0]), std::fabs(dx[3])) +
+                               std::max(std::fabs(dy[0]), std::fabs(dy[3])));
+  if (!(x_lo > tiny || x_hi < -tiny) || !(y_lo > tiny || y_hi < -tiny)) return false;
+  const QuadrantCoeffs& k = quadrant_[(x_lo > 0.0 ? 0u : 1u) | (y_lo > 0.0 ? 0u : 2u)];
+  std::array<double, 4> dc, dr, nc, nr;
+  for (std::size_t i = 0; i < 4; ++i) {
+    dc[i] = k.dx * dx[i];
+    dr[i] = k.dy * dy[i];
+    nc[i] = k.nx * dx[i];
+    nr[i] = k.ny * dy[i];
+  }
+  const std::uint32_t mask = s_.sectors.mask();
+  for (std::size_t i = 0; i < 16; ++i) {
+    const double v = (nc[i & 3] + nr[i >> 2]) / (dc[i & 3] + dr[i >> 2]);  // in [1, 5] scale
+    bucket[i] = static_cast<std::uint32_t>(static_cast<std::int32_t>(v)) & mask;
+  }
+  return true;
 }
 
 /// lround((normalise(atan2(dy, dx) - theta) - amin) / inc), as the reference computes it: the
@@ -192,8 +248,7 @@ inline int ScanClassifier::lastNotSurelyBefore(double dx, double dy, double tol,
 /// square the sides are monotone in the boundary, so this is the sector that testing every
 /// boundary would give; a cell too close to a boundary to tell gets the reference's rounding,
 /// via beamOf. Two cross products when the candidate is right.
-inline long ScanClassifier::sectorIn(double dx, double dy, const SquareInfo& box,
-                                     int start) const {
+inline long ScanClassifier::sectorIn(double dx, double dy, const SquareInfo& box, int start) const {
   const double tol = kRayMargin * (std::fabs(dx) + std::fabs(dy));
   const double* bx = s_.bnd_x.data();
   const double* by = s_.bnd_y.data();

@@ -81,10 +81,17 @@ inline SquareInfo ScanClassifier::classifyInRange(int l, std::int64_t ix0, std::
   SquareInfo info = parent;
   double ax, ay, bx, by;
   extremeCorners(sq, &ax, &ay, &bx, &by);
-  info.slo =
-      lastSurelyPast(ax, ay, kRayMargin * (std::fabs(ax) + std::fabs(ay)), parent.slo, parent.shi);
-  info.shi = lastNotSurelyBefore(bx, by, kRayMargin * (std::fabs(bx) + std::fabs(by)), info.slo,
-                                 parent.shi);
+  // A corner in a sure bucket of the table is surely past every boundary of its sector and
+  // before, surely before every later one: both bisections would return its sector, clamped.
+  const std::int32_t sa = s_.tableSector(ax, ay), sb = s_.tableSector(bx, by);
+  info.slo = sa >= 0 && sa < s_.n
+                 ? std::min(std::max(static_cast<int>(sa), parent.slo), parent.shi)
+                 : lastSurelyPast(ax, ay, kRayMargin * (std::fabs(ax) + std::fabs(ay)), parent.slo,
+                                  parent.shi);
+  info.shi = sb >= 0 && sb < s_.n
+                 ? std::min(std::max(static_cast<int>(sb), info.slo), parent.shi)
+                 : lastNotSurelyBefore(bx, by, kRayMargin * (std::fabs(bx) + std::fabs(by)),
+                                       info.slo, parent.shi);
   info.jlo = std::max(info.slo, 0);
   info.jhi = std::min(info.shi, s_.n - 1);
   const bool partial = info.slo < 0 || info.shi > s_.n - 1;

@@ -62,6 +62,8 @@ class SectorTable {
   std::int32_t at(std::uint32_t b) const { return sector_[b]; }
   const std::int32_t* data() const { return sector_.data(); }
   std::uint32_t mask() const { return mask_; }
+  /// Buckets per unit of pseudo-bearing (a power of two).
+  double scale() const { return scale_; }
   /// The sector of sensor-frame direction (dx, dy) (n outside the fan), or kUnsure.
   std::int32_t sector(double dx, double dy) const { return sector_[bucket(dx, dy)]; }
 
