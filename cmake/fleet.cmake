@@ -8,6 +8,7 @@ endif()
 target_sources(wavog_ros PRIVATE
   src/ros/mapping_ros_fleet.cpp
   src/ros/fleet/placed_scan.cpp
+  src/ros/fleet/range_codec.cpp
   src/ros/fleet/intake.cpp
   src/ros/fleet/fleet_stream.cpp
   src/ros/fleet/fleet_receiver.cpp
@@ -42,6 +43,12 @@ if(CATKIN_ENABLE_TESTING)
       target_link_libraries(test_fleet_merge wavog_ros wavog_sim ${GTEST_MAIN_LIBRARIES})
     endif()
   endif()
+  # The fleet stream's 16-bit range codes (issue 36).
+  catkin_add_gtest(test_range_codec test/ros/test_range_codec.cpp)
+  if(TARGET test_range_codec)
+    target_include_directories(test_range_codec PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
+    target_link_libraries(test_range_codec wavog_ros ${GTEST_MAIN_LIBRARIES})
+  endif()
   # A vehicle's intake (issue 37): counters, refusals, the index sequence.
   catkin_add_gtest(test_fleet_intake test/ros/test_fleet_intake.cpp)
   if(TARGET test_fleet_intake)
@@ -60,8 +67,9 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node
     COMMENT "wavog_simulate: the fleet rostest's bag (3 vehicles, 28 s)")
   add_custom_target(wavog_fleet_test_bag ALL DEPENDS ${WAVOG_FLEET_BAG})
   add_rostest_gtest(test_fleet_system test/fleet.test test/ros/test_fleet_system.cpp)
-  target_link_libraries(test_fleet_system wavog_ros_config wavog_sim wavog_core ${catkin_LIBRARIES}
-                        ${GTEST_LIBRARIES})
+  target_link_libraries(test_fleet_system wavog_ros wavog_ros_config wavog_sim wavog_core
+                        ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+  target_include_directories(test_fleet_system PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
   target_compile_definitions(test_fleet_system PRIVATE
     WAVOG_FLEET_BAG="${WAVOG_FLEET_BAG}" WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
     WAVOG_NODE_BIN="${CATKIN_DEVEL_PREFIX}/lib/wavog_mapping/wavog_mapping_node"

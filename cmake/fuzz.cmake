@@ -62,7 +62,7 @@ if(WAVOG_FUZZ)
       endforeach()
       add_custom_target(wavog_fuzz_msgs DEPENDS ${_headers})
       add_library(wavog_fuzz_fleet_glue STATIC src/ros/fleet/placed_scan.cpp
-        src/ros/fleet/intake.cpp)
+        src/ros/fleet/range_codec.cpp src/ros/fleet/intake.cpp)
       add_dependencies(wavog_fuzz_fleet_glue wavog_fuzz_msgs)
       # catkin_lint: the generated headers live in the fuzz tree (made at build time) by design.
       #catkin_lint: ignore_once MISSING_DIRECTORY EXTERNAL_DIRECTORY EXTERNAL_INTERFACE_PATH

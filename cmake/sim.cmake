@@ -33,8 +33,9 @@ wavog_sim_test(test_ndt_walls wavog_sim_eval)
 
 # ---- wavog_simulate: scenario -> rosbag (rosbag C++ API, no roscore) --------------------------
 set(WAVOG_SIM_BIN_DIR ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
-add_executable(wavog_simulate src/tools/simulate.cpp)
+add_executable(wavog_simulate src/tools/simulate.cpp src/ros/fleet/range_codec.cpp)
 target_include_directories(wavog_simulate SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+target_include_directories(wavog_simulate PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
 target_link_libraries(wavog_simulate PRIVATE wavog_sim wavog_io wavog_tool_support ${catkin_LIBRARIES})
 target_compile_options(wavog_simulate PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_simulate PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${WAVOG_SIM_BIN_DIR})

@@ -37,8 +37,9 @@ fleet-bench: build
 
 # `make fleet-shard-bench` (issue 36): 8, 16 and 32 simulated vehicles' placed-scan streams
 # (wavog_simulate --placed-scans) into 1, 2 and 4 region shards at 1x and 2x real time: CPU per
-# shard, late / lost / refused, lag, kept up or not. Writes FLEET_BENCH_OUT/shard_bench.md and
-# shard_bench.json. About 6 minutes after the build.
+# shard, late / lost / refused, lag, kept up or not; the stream's bytes per scan as float32 and as
+# 16-bit codes. Writes FLEET_BENCH_OUT/shard_bench.md and shard_bench.json. About 6 minutes after
+# the build.
 FLEET_SHARD_VEHICLES ?= 8,16,32
 FLEET_SHARDS ?= 1,2,4
 FLEET_SHARD_RATES ?= 1,2

@@ -9,6 +9,9 @@
    25.6, 38.4 and 51.2 m), rosbag play -r k into them; per shard its CPU time (/proc) over the
    playback, its largest lag_max, and whether it kept up: every scan integrated, nothing late,
    lost or refused, CPU < wall.
+3. The stream's bytes per placed scan, serialised, as the mappers send it by default (16-bit range
+   codes, fleet_stream_format: uint16, which the bags of 1. hold) and as float32 (version 1):
+   wavog_simulate's own count over the smallest N's streams in either format.
 
 Writes OUT/shard_bench.md and OUT/shard_bench.json. usage: fleet_shard_bench.py BIN_DIR SOURCE_DIR
 OUT [DURATION] [VEHICLES] [SHARDS] [RATES] (comma-separated lists; defaults 10, 8,16,32, 1,2,4,
@@ -157,10 +160,29 @@ def run(g, bag, n, shards, rate):
         stop_all(nodes)
 
 
+def stream_bytes(n):
+    """Serialised bytes per placed scan of n vehicles' streams, per fleet_stream_format."""
+    out = {}
+    for fmt in ("float32", "uint16"):
+        bag = os.path.join(OUT, "bytes_%s.bag" % fmt)
+        p = subprocess.run([os.path.join(BIN, "wavog_simulate"), "--vehicles", str(n),
+                            "--duration", str(DURATION), "--seed", "1", "--placed-scans",
+                            "--placed-format", fmt, "--out", bag], check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                           universal_newlines=True)
+        os.remove(bag)
+        for line in p.stderr.splitlines():
+            if "bytes per scan serialised" in line:
+                out[fmt] = float(line.split("): ")[1].split()[0])
+    return out
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     g = Graph()
     runs = []
+    per_scan = stream_bytes(min(VEHICLES))
+    print("fleet-shard-bench: stream bytes per scan %s" % json.dumps(per_scan), flush=True)
     try:
         for n in VEHICLES:
             bag = os.path.join(OUT, "placed%d.bag" % n)
@@ -184,7 +206,8 @@ def main():
     finally:
         g.close()
     with open(os.path.join(OUT, "shard_bench.json"), "w") as f:
-        json.dump({"duration_s": DURATION, "runs": runs}, f, indent=2)
+        json.dump({"duration_s": DURATION, "stream_bytes_per_scan": per_scan, "runs": runs}, f,
+                  indent=2)
     lines = ["# Region shards bench (make fleet-shard-bench)", "",
              "N simulated car-park vehicles' placed-scan streams (wavog_simulate --placed-scans, "
              "%g s, four LMS-291 at 40 Hz each) played with rosbag play -r k into S wavog_fleet "
@@ -195,6 +218,10 @@ def main():
              "under one core." % DURATION, "",
              "| vehicles | shards | rate | per shard: CPU share, outside region, late/lost/refused, "
              "lag max | kept up |", "|---:|---:|---:|---|---|"]
+    lines[4:4] = ["The stream per LMS-291 placed scan (361 beams), serialised: %.0f bytes with "
+                  "float32 ranges (fleet_stream_format: float32, version 1), %.0f bytes with "
+                  "16-bit codes (uint16, version 2, the default, which these bags hold)."
+                  % (per_scan["float32"], per_scan["uint16"]), ""]  # after the paragraph
     for r in runs:
         cells = "; ".join("%.0f %%, %d of %d out, %d/%d/%d, %.2f s"
                           % (100 * p["core_fraction"], p["outside_region"], p["integrated"],

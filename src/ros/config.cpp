@@ -194,6 +194,8 @@ const std::vector<KeyReader>& readers() {
       {"idle_timeout", [](auto& k, auto& v, Config* c) { c->ros.idle_timeout = asDouble(k, v); }},
       // ---- the fleet (issue 30)
       {"fleet_stream", [](auto& k, auto& v, Config* c) { c->ros.fleet_stream = asBool(k, v); }},
+      {"fleet_stream_format",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_stream_format = asString(k, v); }},
       {"vehicle_id", [](auto& k, auto& v, Config* c) { c->ros.vehicle_id = asString(k, v); }},
       {"fleet_vehicles",
        [](auto& k, auto& v, Config* c) { c->ros.fleet_vehicles = asStringList(k, v); }},
@@ -354,6 +356,9 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
     check(!v.empty(), &e, "fleet_vehicles entry must be a non-empty namespace");
     check(vehicles.insert(v).second, &e, "fleet_vehicles entry ('" + v + "') is listed twice");
   }
+  check(ros.fleet_stream_format == "uint16" || ros.fleet_stream_format == "float32", &e,
+        "fleet_stream_format ('" + ros.fleet_stream_format +
+            "') must be one of: uint16 (16-bit range codes, the default), float32");
   check(std::isfinite(ros.fleet_reorder_wait) && ros.fleet_reorder_wait >= 0.0 &&
             ros.fleet_reorder_wait <= 10.0,
         &e, "fleet_reorder_wait (" + fmt(ros.fleet_reorder_wait) + ") must be in [0, 10] s");

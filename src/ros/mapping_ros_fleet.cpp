@@ -28,9 +28,11 @@ void MappingRos::Impl::startFleet(MapperRole role) {
     if (!rp.fleet_stream) return;  // nothing advertised, nothing queued
     std::string vehicle = rp.vehicle_id;
     if (vehicle.empty()) vehicle = nh_.getNamespace();
-    fleet_stream_ = std::make_unique<wavog_fleet::FleetStream>(nh_, vehicle, rp.map_frame);
-    ROS_INFO("%s: streaming integrated scans as vehicle '%s' on %s", pnh_.getNamespace().c_str(),
-             vehicle.c_str(), fleet_stream_->topic().c_str());
+    fleet_stream_ = std::make_unique<wavog_fleet::FleetStream>(
+        nh_, vehicle, rp.map_frame, rp.fleet_stream_format == "uint16");
+    ROS_INFO("%s: streaming integrated scans as vehicle '%s' on %s (ranges as %s)",
+             pnh_.getNamespace().c_str(), vehicle.c_str(), fleet_stream_->topic().c_str(),
+             rp.fleet_stream_format.c_str());
     return;
   }
   if (rp.fleet_stream) {

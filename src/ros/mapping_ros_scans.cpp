@@ -239,6 +239,8 @@ void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& 
   wavog::Pose2 pose;
   wavog::ScanView view = placement.placedView(scan, &compensator_, &pose);
   view.period = in->period.next(scan.header.stamp.toSec(), scan.scan_time);
+  // Streaming 16-bit codes: the map takes the decoded ranges, as the fleet will.
+  if (fleet_stream_) view = fleet_stream_->streamView(view, map_.params());
   const auto t0 = Clock::now();
   const wavog::IntegrateStats st = map_.integrate(pose, view);
   const double dt = std::chrono::duration<double>(Clock::now() - t0).count();

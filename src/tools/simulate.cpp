@@ -8,6 +8,7 @@
 #include <rosbag/bag.h>
 #include <sensor_msgs/LaserScan.h>
 #include <tf2_msgs/TFMessage.h>
+#include <ros/serialization.h>
 #include <wavog_mapping/PlacedScan.h>
 
 #include <cerrno>
@@ -21,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "fleet/range_codec.h"
 #include "tool_support.h"
 #include "wavog_mapping/io/image_io.h"
 #include "wavog_mapping/sim/ground_truth.h"
@@ -61,6 +63,7 @@ struct Options {
   long vehicles = 1;
   std::string vehicle_prefix = "v";
   bool placed_scans = false;  // write each vehicle's PlacedScan stream instead of scans and /tf
+  std::string placed_format = "uint16";  // its ranges: uint16 (version 2) or float32 (version 1)
 };
 
 /// An angle option given in degrees, kept in radians (read whole, as addNumber).
@@ -135,6 +138,12 @@ void addOptions(CLI::App* app, Options* o) {
                 "write each vehicle's stream of placed scans (/<ns>/fleet_scans, PlacedScan, at "
                 "the true sensor pose, as a mapper streams them) instead of its scans and /tf: "
                 "a fleet bag for wavog_fleet (make fleet-bench)");
+  app->add_option("--placed-format", o->placed_format,
+                  "the placed scans' ranges, as a mapper's fleet_stream_format: uint16 (16-bit "
+                  "codes, PlacedScan version 2, for a map without max_range) or float32 "
+                  "(version 1)")
+      ->check(CLI::IsMember({"uint16", "float32"}))
+      ->capture_default_str();
   addPoseNoiseOptions(app, o);
 }
 
@@ -251,6 +260,7 @@ int run(const Options& o) {
 
   const wavog::sim::PoseNoiseParams noise = poseNoise(o);
   std::size_t done = 0, tf_count = 0;
+  std::uint64_t placed_bytes = 0;  // the placed scans serialised
   std::ostringstream summary;
   for (std::size_t k = 0; k < worlds.size(); ++k) {
     const World& w = worlds[k];
@@ -261,10 +271,11 @@ int run(const Options& o) {
     std::vector<std::size_t> per_laser(w.vehicle.lasers.size(), 0);
     SimScan scan;
     std::uint64_t index = 0;
+    wavog_fleet::RangeCodec codec;
     while (o.placed_scans && sim.next(&scan)) {
       const LaserParams& laser = w.vehicle.lasers[static_cast<std::size_t>(scan.laser)];
       wavog_mapping::PlacedScan m;
-      m.version = wavog_mapping::PlacedScan::FORMAT_VERSION;
+      m.version = wavog_mapping::PlacedScan::VERSION_FLOAT32;
       m.header.stamp = t0 + ros::Duration(scan.stamp);
       m.header.frame_id = map_frame;
       m.vehicle = names[k].empty() ? "/" : "/" + names[k];
@@ -279,7 +290,14 @@ int run(const Options& o) {
       m.range_min = view.range_min;
       m.range_max = view.range_max;
       m.period = 1.0 / laser.rate_hz;
-      m.ranges.assign(view.ranges, view.ranges + view.count);
+      if (o.placed_format == "uint16" && codec.encode(view, wavog::MapParams{})) {
+        m.version = wavog_mapping::PlacedScan::VERSION_UINT16;
+        m.range_codes = codec.codes();
+        m.range_step = codec.step();
+      } else {
+        m.ranges.assign(view.ranges, view.ranges + view.count);
+      }
+      placed_bytes += ros::serialization::serializationLength(m);
       bag.write(topic(names[k], "fleet_scans"), m.header.stamp, m);
       ++per_laser[static_cast<std::size_t>(scan.laser)];
       if (++done % 2000 == 0) std::cerr << "\rwavog_simulate: " << done << " placed scans";
@@ -321,6 +339,12 @@ int run(const Options& o) {
             << tf_count << " on /tf (" << o.map_frame << " -> "
             << (o.vehicles > 1 ? o.vehicle_prefix + "<k>/" : "") << o.base_frame
             << "), 1 on /tf_static\n";
+  if (o.placed_scans && done > 0) {
+    std::cerr << "wavog_simulate: placed scans (" << o.placed_format << "): "
+              << std::fixed << std::setprecision(1)
+              << static_cast<double>(placed_bytes) / static_cast<double>(done)
+              << " bytes per scan serialised\n";
+  }
   if (!o.truth_dir.empty()) {
     writeTruth(world, o);
     std::cerr << "wavog_simulate: ground truth in " << o.truth_dir << "/\n";

@@ -97,8 +97,16 @@ std::uint64_t decodeIndex(FuzzedDataProvider* in, const Vehicle& v) {
 
 Msg decodeMessage(FuzzedDataProvider* in, const ros::Time& now, const Vehicle& v) {
   auto m = std::make_shared<wavog_mapping::PlacedScan>();
-  m->version = in->ConsumeBool() ? wavog_mapping::PlacedScan::FORMAT_VERSION
-                                 : in->ConsumeIntegral<std::uint8_t>();
+  switch (in->ConsumeIntegralInRange<int>(0, 2)) {
+    case 0:
+      m->version = wavog_mapping::PlacedScan::VERSION_FLOAT32;
+      break;
+    case 1:
+      m->version = wavog_mapping::PlacedScan::VERSION_UINT16;
+      break;
+    default:
+      m->version = in->ConsumeIntegral<std::uint8_t>();
+  }
   m->header.frame_id = kFrames[in->ConsumeIntegralInRange<std::size_t>(0, std::size(kFrames) - 1)];
   m->header.stamp = decodeStamp(in, now);
   m->header.seq = in->ConsumeIntegral<std::uint32_t>();
@@ -126,8 +134,19 @@ Msg decodeMessage(FuzzedDataProvider* in, const ros::Time& now, const Vehicle& v
   m->range_min = hostileDouble(in, 0.0, 1.0);
   m->range_max = hostileDouble(in, 0.0, 30.0);
   m->period = hostileDouble(in, 0.0, 1.0);
-  m->ranges.resize(in->ConsumeIntegralInRange<std::size_t>(0, kMaxBeams));
-  for (float& r : m->ranges) r = hostileRange(in, 30.0f);
+  // The ranges in the array of the version, mostly; sometimes in the other one or in both.
+  const int arrays = in->ConsumeIntegralInRange<int>(0, 3);  // 0, 1: its own; 2: the other; 3
+  const bool codes = m->version == wavog_mapping::PlacedScan::VERSION_UINT16;
+  const bool own = arrays <= 1;
+  if ((own && !codes) || (arrays == 2 && codes) || arrays == 3) {
+    m->ranges.resize(in->ConsumeIntegralInRange<std::size_t>(0, kMaxBeams));
+    for (float& r : m->ranges) r = hostileRange(in, 30.0f);
+  }
+  if ((own && codes) || (arrays == 2 && !codes) || arrays == 3) {
+    m->range_codes.resize(in->ConsumeIntegralInRange<std::size_t>(0, kMaxBeams));
+    for (std::uint16_t& c : m->range_codes) c = in->ConsumeIntegral<std::uint16_t>();
+    m->range_step = in->ConsumeBool() ? wavog_fleet::kRangeStep : hostileDouble(in, 0.0, 0.01);
+  }
   return m;
 }
 
@@ -176,9 +195,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   now.nsec = in.ConsumeIntegralInRange<std::uint32_t>(0, 999999999u);
   double wall = 0.0;
 
+  std::vector<float> decoded;  // a version-2 message's ranges (as FleetReceiver)
   const auto integrate = [&](Vehicle* v, const wavog_mapping::PlacedScan& m) {
     const wavog::IntegrateStats st =
-        map.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m));
+        map.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m, &decoded));
     // The checks refuse every scan and pose the core would refuse as such.
     WAVOG_FUZZ_CHECK(st.status != wavog::ScanStatus::kBadGeometry &&
                          st.status != wavog::ScanStatus::kBadPose &&
@@ -216,12 +236,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                        "refusal %s without a detail", wavog_fleet::toString(got.refusal));
       const bool period_ok =
           m->period >= 0.0 && m->period <= wavog::ScanPeriod::kMaxPeriod;  // a mapper's
-      if (got.refusal == wavog_fleet::Refusal::kBadSize && period_ok) {
+      // Ranges as a mapper of either version sends them: only its array, a step it may use.
+      const bool arrays_ok =
+          m->version == wavog_mapping::PlacedScan::VERSION_UINT16
+              ? m->ranges.empty() && m->range_step >= wavog_fleet::kRangeStep &&
+                    m->range_step <= wavog_fleet::kMaxRangeStep
+              : m->range_codes.empty();
+      if (got.refusal == wavog_fleet::Refusal::kBadSize && period_ok && arrays_ok) {
         // The converse: what the checks call bad size, the core refuses as such (a mapper's
         // message is never refused for a scan its core integrated); or its period is absurd.
         wavog::WaveletMap scratch(params);
         const wavog::ScanStatus st =
-            scratch.integrate(wavog_fleet::placedPose(*m), wavog_fleet::placedView(*m)).status;
+            scratch.integrate(wavog_fleet::placedPose(*m), wavog_fleet::placedView(*m, &decoded))
+                .status;
         WAVOG_FUZZ_CHECK(st == wavog::ScanStatus::kBadGeometry || st == wavog::ScanStatus::kEmpty,
                          "bad_size to the fleet, %s to the core: %s", wavog::toString(st),
                          got.detail.c_str());

@@ -63,6 +63,7 @@ void expectSame(const Config& a, const Config& b) {
   EXPECT_EQ(a.ros.publish_scales, b.ros.publish_scales);
   EXPECT_EQ(a.ros.scale_aggregation, b.ros.scale_aggregation);
   EXPECT_EQ(a.ros.publish_window, b.ros.publish_window);
+  EXPECT_EQ(a.ros.fleet_stream_format, b.ros.fleet_stream_format);
   EXPECT_EQ(a.ros.update_rate, b.ros.update_rate);
   EXPECT_EQ(a.ros.tf_tolerance, b.ros.tf_tolerance);
   EXPECT_EQ(a.ros.tf_cache_time, b.ros.tf_cache_time);
@@ -188,6 +189,16 @@ TEST(Config, FleetWindowIsBoundedByTheLayerLimit) {
             std::string::npos)
       << errorOf("{fleet_window: 103}");
   EXPECT_NE(errorOf("{fleet_window: -1}").find("fleet_window"), std::string::npos);
+}
+
+TEST(Config, FleetStreamFormatIsOneOfTwo) {
+  EXPECT_EQ(fromYaml("{}").ros.fleet_stream_format, "uint16");  // 16-bit codes by default
+  EXPECT_EQ(fromYaml("{fleet_stream_format: float32}").ros.fleet_stream_format, "float32");
+  EXPECT_NE(errorOf("{fleet_stream_format: float64}")
+                .find("fleet_stream_format ('float64') must be one of: uint16"),
+            std::string::npos)
+      << errorOf("{fleet_stream_format: float64}");
+  EXPECT_NE(errorOf("{fleet_stream_format: 16}").find("fleet_stream_format"), std::string::npos);
 }
 
 TEST(Config, ReportsUnknownKeys) {

@@ -20,7 +20,7 @@ using wavog_fleet::Refusal;
 
 const ros::Time kNow(100.0);
 
-wavog_mapping::PlacedScan goodScan(std::uint64_t index) {
+wavog_mapping::PlacedScan goodScan(std::uint64_t index, bool codes = false) {
   const std::vector<float> ranges(181, 5.0f);
   wavog::ScanView view;
   view.ranges = ranges.data();
@@ -30,8 +30,11 @@ wavog_mapping::PlacedScan goodScan(std::uint64_t index) {
   view.range_min = 0.1;
   view.range_max = 80.0;
   wavog_mapping::PlacedScan m;
+  wavog_fleet::RangeCodec codec;
+  if (codes) EXPECT_TRUE(codec.encode(view, wavog::MapParams{}));
   wavog_fleet::fillPlacedScan(kNow, "map", "v1", "/v1/scan", index, wavog::Pose2{1, 2, 0.5}, view,
-                              false, wavog::Pose2{1, 2, 0.5}, wavog::Pose2{1, 2, 0.5}, &m);
+                              false, wavog::Pose2{1, 2, 0.5}, wavog::Pose2{1, 2, 0.5}, &m,
+                              codes ? &codec : nullptr);
   return m;
 }
 
@@ -104,6 +107,51 @@ TEST(FleetIntake, LostSaturates) {
   EXPECT_EQ(wavog_fleet::saturatingAdd(std::numeric_limits<std::uint64_t>::max() - 1, 5),
             std::numeric_limits<std::uint64_t>::max());
   EXPECT_EQ(wavog_fleet::saturatingAdd(3, 4), 7u);
+}
+
+TEST(FleetIntake, BothStreamVersionsAreReadAndAnyOtherRefused) {
+  Stream s;
+  const auto floats = goodScan(0);
+  const auto codes = goodScan(1, true);
+  EXPECT_EQ(floats.version, wavog_mapping::PlacedScan::VERSION_FLOAT32);
+  EXPECT_EQ(codes.version, wavog_mapping::PlacedScan::VERSION_UINT16);
+  EXPECT_EQ(codes.range_codes.size(), 181u);
+  EXPECT_TRUE(codes.ranges.empty());
+  EXPECT_EQ(codes.range_step, 80.0 / wavog_fleet::kMaxHitCode);  // range_max 80 m: 1.22 mm
+  EXPECT_EQ(s.take(floats).refusal, Refusal::kNone);
+  const std::uint64_t float_bytes = s.c.bytes;
+  EXPECT_EQ(s.take(codes).refusal, Refusal::kNone);
+  // 181 beams: 2 bytes each instead of 4 (both versions carry both arrays' lengths and the step).
+  EXPECT_EQ(s.c.bytes - float_bytes, float_bytes - 181u * 2u);
+  // The codes decode to the ranges the mapper integrated.
+  std::vector<float> decoded;
+  const wavog::ScanView v = wavog_fleet::placedView(codes, &decoded);
+  ASSERT_EQ(v.count, 181u);
+  EXPECT_EQ(v.ranges, decoded.data());
+  EXPECT_NEAR(v.ranges[0], 5.0f, 0.5 * codes.range_step);
+  // Any other version is refused, whichever array it fills.
+  for (const std::uint8_t version : {0, 3, 255}) {
+    auto m = goodScan(2, version == 3);
+    m.version = version;
+    EXPECT_EQ(s.take(m).refusal, Refusal::kVersion) << int{version};
+  }
+  // A version's ranges in the other array, or both, or a step no mapper sends: bad size.
+  auto m = goodScan(5, true);
+  m.version = wavog_mapping::PlacedScan::VERSION_FLOAT32;  // codes under version 1
+  EXPECT_EQ(s.take(m).refusal, Refusal::kBadSize);
+  m = goodScan(6);
+  m.version = wavog_mapping::PlacedScan::VERSION_UINT16;  // floats under version 2
+  EXPECT_EQ(s.take(m).refusal, Refusal::kBadSize);
+  m = goodScan(7, true);
+  m.ranges.assign(181, 5.0f);  // both
+  EXPECT_EQ(s.take(m).refusal, Refusal::kBadSize);
+  for (const double step : {0.0, 1e-4, -0.001, std::nan(""), 1e3}) {
+    m = goodScan(8, true);
+    m.range_step = step;
+    EXPECT_EQ(s.take(m).refusal, Refusal::kBadSize) << step;
+  }
+  EXPECT_EQ(s.c.dropped_version, 3u);
+  EXPECT_EQ(s.c.dropped_bad_size, 8u);
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ wavog_mapping::FleetStatus::ConstPtr g_status;
 /// Scan i of vehicle v1, standing at (0.1 i, 0) in a round room of radius 3 m, 10 Hz.
 wavog_mapping::PlacedScan placedScan(int i, const ros::Time& t0) {
   wavog_mapping::PlacedScan m;
-  m.version = wavog_mapping::PlacedScan::FORMAT_VERSION;
+  m.version = wavog_mapping::PlacedScan::VERSION_FLOAT32;
   m.header.stamp = t0 + ros::Duration(0.1 * i);
   m.header.frame_id = "map";
   m.vehicle = "v1";

@@ -7,6 +7,7 @@
 #include <ros/serialization.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <cmath>
 #include <limits>
@@ -139,7 +140,9 @@ Refusal check(const wavog_mapping::PlacedScan& m) {
 TEST(PlacedScanCheck, RefusesForeignInputByName) {
   EXPECT_EQ(check(goodScan()), Refusal::kNone);
   auto m = goodScan();
-  m.version = 2;  // a future writer
+  m.version = 3;  // a future writer
+  EXPECT_EQ(check(m), Refusal::kVersion);
+  m.version = 0;
   EXPECT_EQ(check(m), Refusal::kVersion);
   m = goodScan();
   m.header.frame_id = "odom";
@@ -221,8 +224,17 @@ struct Placed {
   wavog_mapping::PlacedScan msg;  ///< as received (serialised and back)
 };
 
-/// Every scan of `vehicles` vehicles of a short car-park run, as their mappers would stream them.
-std::vector<Placed> fleetScans(int vehicles, double duration) {
+/// The map parameters of the merge tests' vehicles (`type`'s defaults, 10 cm).
+wavog::MapParams mergeParams(wavog::PolicyType type) {
+  wavog::MapParams params = wavog::MapParams::defaultsFor(type);
+  params.grid.resolution = 0.1;
+  return params;
+}
+
+/// Every scan of `vehicles` vehicles of a short car-park run, as their mappers would stream them:
+/// with `codes`, as 16-bit codes (PlacedScan version 2, as FleetStream::streamView() encodes them
+/// for a map of mergeParams()), else as float32 (version 1).
+std::vector<Placed> fleetScans(int vehicles, double duration, bool codes = false) {
   std::vector<Placed> out;
   const wavog::sim::World base = wavog::sim::defaultWorld(duration);
   for (int k = 0; k < vehicles; ++k) {
@@ -230,14 +242,19 @@ std::vector<Placed> fleetScans(int vehicles, double duration) {
     wavog::sim::ScanSimulator sim(w, 11 + static_cast<std::uint64_t>(k));
     wavog::sim::SimScan s;
     std::uint64_t index = 0;
+    wavog_fleet::RangeCodec codec;
     while (sim.next(&s)) {
       const auto& laser = w.vehicle.lasers[static_cast<std::size_t>(s.laser)];
       wavog::ScanView view = s.view(laser);
       view.period = 1.0 / laser.rate_hz;
       wavog_mapping::PlacedScan m;
       const ros::Time stamp(1000.0 + s.stamp);
+      const bool encoded =
+          codes && codec.encode(view, mergeParams(wavog::PolicyType::kForget));
+      EXPECT_EQ(encoded, codes);
       wavog_fleet::fillPlacedScan(stamp, "map", "v" + std::to_string(k), laser.topic, index,
-                                  s.sensor_pose, view, false, s.sensor_pose, s.sensor_pose, &m);
+                                  s.sensor_pose, view, false, s.sensor_pose, s.sensor_pose, &m,
+                                  encoded ? &codec : nullptr);
       // Through the wire format.
       const std::uint32_t n = ros::serialization::serializationLength(m);
       std::vector<std::uint8_t> bytes(n);
@@ -275,9 +292,11 @@ void expectSameCells(const wavog::WaveletMap& a, const wavog::WaveletMap& b, con
   EXPECT_GT(known, 10000u) << what;  // a real map, not two empty ones
 }
 
-TEST(FleetMerge, FleetMapEqualsOneMapOfAllScansInStampOrderForEveryPolicy) {
-  const std::vector<Placed> scans = fleetScans(3, 2.0);
+/// The merge rule for every policy, the streams as 16-bit codes or as float32.
+void expectMergeRuleForEveryPolicy(bool codes) {
+  const std::vector<Placed> scans = fleetScans(3, 2.0, codes);
   ASSERT_GT(scans.size(), 900u);
+  std::vector<float> decoded;  // a version-2 scan's ranges (as FleetReceiver)
   // Arrival: each scan up to 0.25 s after its stamp, vehicles interleaved at random.
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> delay(0.0, 0.25);
@@ -300,8 +319,7 @@ TEST(FleetMerge, FleetMapEqualsOneMapOfAllScansInStampOrderForEveryPolicy) {
                        Case{PolicyType::kClamp, 0}, Case{PolicyType::kForget, 0},
                        Case{PolicyType::kForget, 0.5}, Case{PolicyType::kClampLower, 0},
                        Case{PolicyType::kClampUpper, 0}}) {
-    wavog::MapParams params = wavog::MapParams::defaultsFor(c.type);
-    params.grid.resolution = 0.1;
+    wavog::MapParams params = mergeParams(c.type);
     params.policy.forget_half_life = c.half_life;
     const std::string what = std::string(wavog::toString(c.type)) +
                              (c.half_life > 0 ? " (forget_half_life)" : "");
@@ -316,7 +334,7 @@ TEST(FleetMerge, FleetMapEqualsOneMapOfAllScansInStampOrderForEveryPolicy) {
                                              m.header.stamp, nullptr),
                 Refusal::kNone);
       const wavog::IntegrateStats st =
-          fleet.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m));
+          fleet.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m, &decoded));
       integrated += st.status == wavog::ScanStatus::kOk;
     };
     for (const auto& a : arrivals) {
@@ -330,10 +348,79 @@ TEST(FleetMerge, FleetMapEqualsOneMapOfAllScansInStampOrderForEveryPolicy) {
     wavog::WaveletMap single(params);
     for (std::size_t i : stamp_order) {
       const auto& m = scans[i].msg;
-      single.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m));
+      single.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m, &decoded));
     }
     expectSameCells(fleet, single, what.c_str());
   }
+}
+
+TEST(FleetMerge, FleetMapEqualsOneMapOfAllScansInStampOrderForEveryPolicy) {
+  expectMergeRuleForEveryPolicy(true);  // the default stream (fleet_stream_format: uint16)
+}
+
+TEST(FleetMerge, FleetMapEqualsOneMapOfAllScansInStampOrderFloatStream) {
+  expectMergeRuleForEveryPolicy(false);  // fleet_stream_format: float32
+}
+
+TEST(FleetMerge, VehicleMapEqualsFleetMapOfItsCodedStream) {
+  // A mapper streaming 16-bit codes integrates the decoded ranges (FleetStream::streamView()); a
+  // fleet node integrates the codes it receives, decoded: the same floats, the same map. And the
+  // codes are not the floats: without them the maps would differ, so the test is not vacuous.
+  const wavog::MapParams params = mergeParams(wavog::PolicyType::kForget);
+  const wavog::sim::World w = wavog::sim::defaultWorld(2.0);
+  wavog::sim::ScanSimulator sim(w, 11);
+  wavog::sim::SimScan s;
+  wavog::WaveletMap vehicle(params), fleet(params), unquantised(params);
+  wavog_fleet::RangeCodec codec;
+  std::vector<float> decoded;
+  std::size_t scans = 0, changed_ranges = 0;
+  while (sim.next(&s)) {
+    const auto& laser = w.vehicle.lasers[static_cast<std::size_t>(s.laser)];
+    wavog::ScanView view = s.view(laser);
+    view.period = 1.0 / laser.rate_hz;
+    ASSERT_TRUE(codec.encode(view, params));
+    const wavog::ScanView integrated = codec.decodedView(view);
+    for (std::size_t j = 0; j < view.count; ++j) {
+      changed_ranges += std::memcmp(&view.ranges[j], &integrated.ranges[j], sizeof(float)) != 0;
+    }
+    ASSERT_EQ(vehicle.integrate(s.sensor_pose, integrated).status, wavog::ScanStatus::kOk);
+    unquantised.integrate(s.sensor_pose, view);
+    wavog_mapping::PlacedScan m;
+    wavog_fleet::fillPlacedScan(ros::Time(1000.0 + s.stamp), "map", "v1", laser.topic, scans++,
+                                s.sensor_pose, integrated, false, s.sensor_pose, s.sensor_pose, &m,
+                                &codec);
+    ASSERT_EQ(m.version, wavog_mapping::PlacedScan::VERSION_UINT16);
+    ASSERT_TRUE(m.ranges.empty());
+    // Through the wire format.
+    const std::uint32_t n = ros::serialization::serializationLength(m);
+    std::vector<std::uint8_t> bytes(n);
+    ros::serialization::OStream os(bytes.data(), n);
+    ros::serialization::serialize(os, m);
+    wavog_mapping::PlacedScan got;
+    ros::serialization::IStream is(bytes.data(), n);
+    ros::serialization::deserialize(is, got);
+    ASSERT_EQ(wavog_fleet::checkPlacedScan(got, wavog_fleet::PlacedScanLimits{},
+                                           got.header.stamp, nullptr),
+              Refusal::kNone);
+    ASSERT_EQ(fleet.integrate(wavog_fleet::placedPose(got), wavog_fleet::placedView(got, &decoded))
+                  .status,
+              wavog::ScanStatus::kOk);
+  }
+  ASSERT_GT(scans, 300u);
+  EXPECT_GT(changed_ranges, scans * 100);  // most returns moved by up to half a millimetre
+  expectSameCells(vehicle, fleet, "vehicle and fleet");
+  std::size_t differ = 0, known = 0;
+  wavog::CellBox box;
+  ASSERT_TRUE(vehicle.bounds(0, &box));
+  const wavog::Raster a = vehicle.exportScale(0, box, wavog::Aggregation::kMean);
+  const wavog::Raster b = unquantised.exportScale(0, box, wavog::Aggregation::kMean);
+  for (std::size_t i = 0; i < a.log_odds.size(); ++i) {
+    known += a.known[i];
+    differ += std::memcmp(&a.log_odds[i], &b.log_odds[i], sizeof(float)) != 0;
+  }
+  EXPECT_GT(differ, 0u);
+  std::printf("vehicle map of the codes vs of the floats: %zu of %zu known cells differ\n",
+              differ, known);
 }
 
 TEST(FleetMerge, OrderMattersUnderForgettingSoTheRuleIsNotVacuous) {
@@ -344,11 +431,17 @@ TEST(FleetMerge, OrderMattersUnderForgettingSoTheRuleIsNotVacuous) {
   std::vector<std::size_t> by_stamp = by_vehicle;
   std::sort(by_stamp.begin(), by_stamp.end(),
             [&](std::size_t a, std::size_t b) { return scans[a].key < scans[b].key; });
-  wavog::MapParams params = wavog::MapParams::defaultsFor(wavog::PolicyType::kForget);
-  params.grid.resolution = 0.1;
+  const wavog::MapParams params = mergeParams(wavog::PolicyType::kForget);
   wavog::WaveletMap a(params), b(params);
-  for (std::size_t i : by_vehicle) a.integrate(wavog_fleet::placedPose(scans[i].msg), wavog_fleet::placedView(scans[i].msg));
-  for (std::size_t i : by_stamp) b.integrate(wavog_fleet::placedPose(scans[i].msg), wavog_fleet::placedView(scans[i].msg));
+  std::vector<float> decoded;
+  for (std::size_t i : by_vehicle) {
+    a.integrate(wavog_fleet::placedPose(scans[i].msg),
+                wavog_fleet::placedView(scans[i].msg, &decoded));
+  }
+  for (std::size_t i : by_stamp) {
+    b.integrate(wavog_fleet::placedPose(scans[i].msg),
+                wavog_fleet::placedView(scans[i].msg, &decoded));
+  }
   wavog::CellBox box;
   ASSERT_TRUE(b.bounds(0, &box));
   const wavog::Raster ra = a.exportScale(0, box, wavog::Aggregation::kMean);

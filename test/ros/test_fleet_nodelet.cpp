@@ -27,7 +27,7 @@ constexpr int kBeams = 181;
 /// Scan i of a laser driving along x at 1 m/s past a wall 3 m to its left, 40 Hz.
 wavog_mapping::PlacedScan placedScan(int i, const ros::Time& t0) {
   wavog_mapping::PlacedScan m;
-  m.version = wavog_mapping::PlacedScan::FORMAT_VERSION;
+  m.version = wavog_mapping::PlacedScan::VERSION_FLOAT32;
   m.header.stamp = t0 + ros::Duration(0.025 * i);
   m.header.frame_id = "map";
   m.vehicle = "v1";

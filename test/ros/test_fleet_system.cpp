@@ -1,8 +1,9 @@
 // A fleet over ROS (issue 30; test/fleet.test): three simulated car-park vehicles, each mapper in
 // its own process and namespace streaming the scans it integrated, one wavog_fleet node. v1 runs
 // from the start (launch), v2 is started by this test and killed (SIGKILL) at 15 s, v3 starts 20 s
-// late. Checks: the fleet map equals, cell for cell, one map fed every streamed scan in stamp
-// order; it gets at least as many ground-truth cells right as the best single vehicle; v2 is
+// late. Checks: the streams are the default 16-bit codes (PlacedScan version 2); the fleet map
+// equals, cell for cell, one map fed every streamed scan in stamp order, and v1's and v3's own
+// maps their streams replayed alone (the mappers integrated the decoded codes); it gets at least as many ground-truth cells right as the best single vehicle; v2 is
 // stale in ~fleet_status and /diagnostics and its cells stay; v3 is caught up. Each process has
 // its own loopback address (fleet.test), as on distinct hosts: checked at the master. A fleet
 // node started after the run from the first one's save_map (map_file) holds that map exactly.
@@ -25,6 +26,7 @@
 #include <tuple>
 #include <vector>
 
+#include "fleet/placed_scan.h"
 #include "wavog_mapping/FleetStatus.h"
 #include "wavog_mapping/PlacedScan.h"
 #include "wavog_mapping/SaveMap.h"
@@ -273,7 +275,13 @@ TEST(Fleet, ThreeVehiclesOneMap) {
                   v.dropped_version + v.dropped_frame + v.dropped_bad_stamp + v.dropped_bad_pose +
                   v.dropped_bad_size + v.dropped_refused + v.dropped_overflow,
               0u);
-    EXPECT_GT(v.bytes, scans[k].size() * 1444u);  // 361 ranges of 4 bytes each, and more
+    // The default stream (fleet_stream_format: uint16): 361 ranges of 2 bytes each, and more.
+    for (const auto& m : scans[k]) {
+      ASSERT_EQ(m->version, wavog_mapping::PlacedScan::VERSION_UINT16);
+      ASSERT_EQ(m->range_codes.size(), 361u);
+    }
+    EXPECT_GT(v.bytes, scans[k].size() * 722u);
+    EXPECT_LT(v.bytes, scans[k].size() * 1444u);
     for (std::size_t i = 0; i < scans[k].size(); ++i) ASSERT_EQ(scans[k][i]->index, i);
     total += scans[k].size();
     // A scan reaches the published layers after its integration: the largest lag to the layers'
@@ -292,17 +300,12 @@ TEST(Fleet, ThreeVehiclesOneMap) {
     for (const auto& m : scans[k]) all.emplace_back(m->header.stamp, k, m->index, m.get());
   std::sort(all.begin(), all.end());
   wavog::WaveletMap single(config.map);
+  std::vector<float> decoded;  // a version-2 scan's ranges
   for (const auto& e : all) {
     const wavog_mapping::PlacedScan& m = *std::get<3>(e);
-    wavog::ScanView view;
-    view.ranges = m.ranges.data();
-    view.count = m.ranges.size();
-    view.angle_min = m.angle_min;
-    view.angle_increment = m.angle_increment;
-    view.range_min = m.range_min;
-    view.range_max = m.range_max;
-    view.period = m.period;
-    ASSERT_EQ(single.integrate(wavog::Pose2{m.x, m.y, m.theta}, view).status, wavog::ScanStatus::kOk);
+    ASSERT_EQ(single.integrate(wavog_fleet::placedPose(m), wavog_fleet::placedView(m, &decoded))
+                  .status,
+              wavog::ScanStatus::kOk);
   }
   const wavog::WaveletMap fleet = loadMap(config.map, stem + "_fleet.wmap");
   wavog::CellBox bf, bs;
@@ -348,6 +351,33 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   }
   EXPECT_EQ(differ_late, 0u) << "of " << rf.log_odds.size() << " cells";
 
+  // ---- each vehicle's own map is its stream replayed alone (v1, v3; v2's map may hold a few
+  // scans it integrated but never sent before SIGKILL): the mapper integrated the decoded codes,
+  // as the fleet node did.
+  for (const std::size_t k : {std::size_t{0}, std::size_t{2}}) {
+    SCOPED_TRACE(kVehicles[k]);
+    wavog::WaveletMap replayed(config.map);
+    for (const auto& m : scans[k]) {
+      ASSERT_EQ(replayed.integrate(wavog_fleet::placedPose(*m), wavog_fleet::placedView(*m, &decoded))
+                    .status,
+                wavog::ScanStatus::kOk);
+    }
+    const wavog::WaveletMap own = loadMap(config.map, stem + "_" + kVehicles[k] + ".wmap");
+    wavog::CellBox bo, br;
+    ASSERT_TRUE(own.bounds(0, &bo));
+    ASSERT_TRUE(replayed.bounds(0, &br));
+    ASSERT_TRUE(bo.min_x == br.min_x && bo.min_y == br.min_y && bo.max_x == br.max_x &&
+                bo.max_y == br.max_y);
+    const wavog::Raster ro = own.exportScale(0, bo, wavog::Aggregation::kMean);
+    const wavog::Raster rr = replayed.exportScale(0, br, wavog::Aggregation::kMean);
+    std::size_t differ_own = 0;
+    for (std::size_t i = 0; i < ro.log_odds.size(); ++i) {
+      differ_own += ro.known[i] != rr.known[i] ||
+                    std::memcmp(&ro.log_odds[i], &rr.log_odds[i], sizeof(float)) != 0;
+    }
+    EXPECT_EQ(differ_own, 0u) << "of " << ro.log_odds.size() << " cells";
+  }
+
   // ---- ground truth: the fleet gets at least as many cells right as the best single vehicle.
   const double end = 28.0;
   const wavog::sim::World world = wavog::sim::defaultWorld(end);
@@ -364,15 +394,7 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   {
     wavog::WaveletMap streamed(config.map);
     for (const auto& m : scans[1]) {
-      wavog::ScanView view;
-      view.ranges = m->ranges.data();
-      view.count = m->ranges.size();
-      view.angle_min = m->angle_min;
-      view.angle_increment = m->angle_increment;
-      view.range_min = m->range_min;
-      view.range_max = m->range_max;
-      view.period = m->period;
-      streamed.integrate(wavog::Pose2{m->x, m->y, m->theta}, view);
+      streamed.integrate(wavog_fleet::placedPose(*m), wavog_fleet::placedView(*m, &decoded));
     }
     wavog::CellBox b;
     ASSERT_TRUE(streamed.bounds(0, &b));

@@ -79,6 +79,10 @@ struct RosParams {
   /// Mapper: publish every scan it integrates, placed in map_frame, on fleet_scans
   /// (wavog_mapping/PlacedScan) for a fleet node. Off: no publisher, no cost.
   bool fleet_stream = false;
+  /// Mapper: how the stream carries ranges: "uint16" (PlacedScan version 2: 16-bit codes of 1 mm,
+  /// which the mapper integrates decoded, so that its map and the fleet's agree exactly) or
+  /// "float32" (version 1: the ranges as read). A fleet node reads both.
+  std::string fleet_stream_format = "uint16";
   /// Mapper: the vehicle id in the stream; empty: the node's namespace.
   std::string vehicle_id;
   /// Fleet node: the vehicles' namespaces (1 to kMaxFleetVehicles); it subscribes to

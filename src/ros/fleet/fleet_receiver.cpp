@@ -161,7 +161,7 @@ std::size_t FleetReceiver::releaseAll() {
 }
 
 void FleetReceiver::integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan& m) {
-  const wavog::IntegrateStats st = integrate_(placedPose(m), placedView(m));
+  const wavog::IntegrateStats st = integrate_(placedPose(m), placedView(m, &decoded_));
   wavog_mapping::VehicleStatus& c = v->c;
   if (st.status != wavog::ScanStatus::kOk) {
     ++c.dropped_refused;

@@ -74,6 +74,7 @@ class FleetReceiver {
   std::mutex* mutex_;
   IntegrateFn integrate_;
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
+  std::vector<float> decoded_;  ///< a version-2 scan's ranges (under *mutex_)
   ReorderBuffer<Item> buffer_;
   ros::Time integrated_stamp_;
   ros::Publisher status_pub_;

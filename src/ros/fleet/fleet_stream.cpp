@@ -21,12 +21,19 @@ constexpr std::size_t kMaxHeld = 800;
 
 }  // namespace
 
-FleetStream::FleetStream(ros::NodeHandle nh, std::string vehicle, std::string map_frame)
-    : vehicle_(std::move(vehicle)), map_frame_(std::move(map_frame)) {
+FleetStream::FleetStream(ros::NodeHandle nh, std::string vehicle, std::string map_frame,
+                         bool codes)
+    : vehicle_(std::move(vehicle)), map_frame_(std::move(map_frame)), codes_(codes) {
   pub_ = nh.advertise<wavog_mapping::PlacedScan>("fleet_scans", kQueue);
   topic_ = pub_.getTopic();
   timer_ = nh.createWallTimer(ros::WallDuration(kSweepPeriod),
                               [this](const ros::WallTimerEvent&) { publishQueued(); });
+}
+
+wavog::ScanView FleetStream::streamView(const wavog::ScanView& view,
+                                        const wavog::MapParams& params) {
+  encoded_ = codes_ && codec_.encode(view, params);
+  return encoded_ ? codec_.decodedView(view) : view;
 }
 
 void FleetStream::queue(const ros::Time& stamp, const std::string& input,
@@ -35,7 +42,7 @@ void FleetStream::queue(const ros::Time& stamp, const std::string& input,
   auto m = boost::make_shared<wavog_mapping::PlacedScan>();
   std::lock_guard<std::mutex> lock(mutex_);
   fillPlacedScan(stamp, map_frame_, vehicle_, input, index_++, pose, view, compensated, start,
-                 end, m.get());
+                 end, m.get(), encoded_ ? &codec_ : nullptr);
   queued_.push_back(std::move(m));
 }
 

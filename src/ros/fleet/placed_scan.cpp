@@ -44,8 +44,9 @@ void fillPlacedScan(const ros::Time& stamp, const std::string& map_frame,
                     const std::string& vehicle, const std::string& input, std::uint64_t index,
                     const wavog::Pose2& pose, const wavog::ScanView& view, bool compensated,
                     const wavog::Pose2& start, const wavog::Pose2& end,
-                    wavog_mapping::PlacedScan* m) {
-  m->version = wavog_mapping::PlacedScan::FORMAT_VERSION;
+                    wavog_mapping::PlacedScan* m, const RangeCodec* codes) {
+  m->version = codes ? wavog_mapping::PlacedScan::VERSION_UINT16
+                     : wavog_mapping::PlacedScan::VERSION_FLOAT32;
   m->header.stamp = stamp;
   m->header.frame_id = map_frame;
   m->vehicle = vehicle;
@@ -66,7 +67,20 @@ void fillPlacedScan(const ros::Time& stamp, const std::string& map_frame,
   m->range_min = view.range_min;
   m->range_max = view.range_max;
   m->period = view.period;
-  m->ranges.assign(view.ranges, view.ranges + view.count);
+  if (codes) {
+    m->ranges.clear();
+    m->range_codes = codes->codes();
+    m->range_step = codes->step();
+  } else {
+    m->ranges.assign(view.ranges, view.ranges + view.count);
+    m->range_codes.clear();
+    m->range_step = 0.0;
+  }
+}
+
+std::size_t placedBeams(const wavog_mapping::PlacedScan& m) {
+  return m.version == wavog_mapping::PlacedScan::VERSION_UINT16 ? m.range_codes.size()
+                                                                : m.ranges.size();
 }
 
 Refusal checkPlacedScan(const wavog_mapping::PlacedScan& m, const PlacedScanLimits& limits,
@@ -74,10 +88,13 @@ Refusal checkPlacedScan(const wavog_mapping::PlacedScan& m, const PlacedScanLimi
   std::ostringstream d;
   Refusal r = Refusal::kNone;
   const double offset = wavog_ros::secondsBetween(m.header.stamp, now);
-  const double n_beams = static_cast<double>(m.ranges.size());
-  if (m.version != wavog_mapping::PlacedScan::FORMAT_VERSION) {
+  const bool codes = m.version == wavog_mapping::PlacedScan::VERSION_UINT16;
+  const std::size_t beams = placedBeams(m);
+  const double n_beams = static_cast<double>(beams);
+  if (m.version != wavog_mapping::PlacedScan::VERSION_FLOAT32 && !codes) {
     d << "format version " << static_cast<int>(m.version) << ", this node reads "
-      << static_cast<int>(wavog_mapping::PlacedScan::FORMAT_VERSION);
+      << static_cast<int>(wavog_mapping::PlacedScan::VERSION_FLOAT32) << " (float32 ranges) and "
+      << static_cast<int>(wavog_mapping::PlacedScan::VERSION_UINT16) << " (16-bit codes)";
     r = Refusal::kVersion;
   } else if (m.header.frame_id != limits.map_frame) {
     d << "frame_id '" << m.header.frame_id << "', the fleet maps in '" << limits.map_frame << "'";
@@ -103,7 +120,15 @@ Refusal checkPlacedScan(const wavog_mapping::PlacedScan& m, const PlacedScanLimi
       << " rad, |x|, |y| < " << static_cast<double>(wavog::kCellIndexLimit) * limits.resolution
       << " m (the map's extent)";
     r = Refusal::kBadPose;
-  } else if (m.ranges.empty() || m.ranges.size() > wavog::kMaxBeams ||
+  } else if (codes ? !m.ranges.empty() ||
+                         !(m.range_step >= kRangeStep && m.range_step <= kMaxRangeStep)
+                   : !m.range_codes.empty()) {
+    d << "version " << static_cast<int>(m.version) << " with " << m.ranges.size()
+      << " float ranges, " << m.range_codes.size() << " range codes, range_step "
+      << m.range_step << " m: version 1 fills ranges only, version 2 range_codes only, with "
+      << "range_step in [" << kRangeStep << ", " << kMaxRangeStep << "] m";
+    r = Refusal::kBadSize;
+  } else if (beams == 0 || beams > wavog::kMaxBeams ||
              !(std::abs(m.angle_min) <= wavog::kMaxAbsAngleMin) ||
              !(std::abs(m.angle_increment) >= wavog::kMinAbsAngleIncrement) ||
              !std::isfinite(m.angle_increment) ||
@@ -135,10 +160,16 @@ wavog::Pose2 placedPose(const wavog_mapping::PlacedScan& m) {
   return p;
 }
 
-wavog::ScanView placedView(const wavog_mapping::PlacedScan& m) {
+wavog::ScanView placedView(const wavog_mapping::PlacedScan& m, std::vector<float>* decoded) {
   wavog::ScanView v;
-  v.ranges = m.ranges.data();
-  v.count = m.ranges.size();
+  if (m.version == wavog_mapping::PlacedScan::VERSION_UINT16) {
+    decodeRanges(m.range_codes.data(), m.range_codes.size(), m.range_step, decoded);
+    v.ranges = decoded->data();
+    v.count = decoded->size();
+  } else {
+    v.ranges = m.ranges.data();
+    v.count = m.ranges.size();
+  }
   v.angle_min = m.angle_min;
   v.angle_increment = m.angle_increment;
   v.range_min = m.range_min;
