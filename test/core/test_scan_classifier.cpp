@@ -280,3 +280,28 @@ TEST(PreparedScan, HitCellsAreTheReferencesAtCellEdges) {
 
 }  // namespace
 }  // namespace wavog_test
+
+// The SSE2 quotient of a 4 x 4 group's buckets is the scalar expression, bit for bit, including
+// quotients just below and above an integer and the table mask's wrap.
+TEST(ScanNumerics, QuotientBucketsAreTheScalarQuotient) {
+  std::mt19937 rng(3401u);
+  std::uniform_real_distribution<double> term(-3.0, 3.0), den(0.5, 4.0);
+  const std::uint32_t mask = 1023u;
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::array<double, 4> nc, nr, dc, dr;
+    for (std::size_t i = 0; i < 4; ++i) {
+      dc[i] = den(rng);
+      dr[i] = den(rng);
+      nc[i] = 256.0 * (dc[i] + term(rng));
+      nr[i] = 256.0 * dr[i];
+    }
+    if (trial % 7 == 0) nc[1] = 300.0 * (dc[1] + dr[2]) - nr[2];  // an exact integer quotient
+    std::array<std::uint32_t, 16> got{};
+    wavog::detail::quotientBuckets16(nc.data(), nr.data(), dc.data(), dr.data(), mask, got.data());
+    for (std::size_t i = 0; i < 16; ++i) {
+      const double v = (nc[i & 3] + nr[i >> 2]) / (dc[i & 3] + dr[i >> 2]);
+      ASSERT_EQ(got[i], static_cast<std::uint32_t>(static_cast<std::int32_t>(v)) & mask)
+          << "trial " << trial << " cell " << i << " quotient " << v;
+    }
+  }
+}

@@ -190,11 +190,8 @@ inline bool ScanClassifier::quadrantBuckets(const std::array<double, 4>& dx,
     nc[i] = k.nx * dx[i];
     nr[i] = k.ny * dy[i];
   }
-  const std::uint32_t mask = s_.sectors.mask();
-  for (std::size_t i = 0; i < 16; ++i) {
-    const double v = (nc[i & 3] + nr[i >> 2]) / (dc[i & 3] + dr[i >> 2]);  // in [1, 5] scale
-    bucket[i] = static_cast<std::uint32_t>(static_cast<std::int32_t>(v)) & mask;
-  }
+  // (nc + nr) / (dc + dr) lies in [1, 5] scale.
+  quotientBuckets16(nc.data(), nr.data(), dc.data(), dr.data(), s_.sectors.mask(), bucket);
   return true;
 }
 
