@@ -1,7 +1,7 @@
 // The scan classifier alone, without a map, against the dense reference's cell-by-cell model:
 // every cell's class exact, every square's class conservative (E only if all its cells are E, U
-// only if all are U, FREE_OR_UNKNOWN only without O), the 4 x 4 groups exact, on seeded random
-// scans with every kind of bad beam (NaN, +-inf, 0, below range_min, beyond range_max).
+// only if all are U, FREE_OR_UNKNOWN only without O), the 4 x 4 and 8 x 8 groups exact, on seeded
+// random scans with every kind of bad beam (NaN, +-inf, 0, below range_min, beyond range_max).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -29,6 +29,7 @@ struct Seen {
   std::array<std::size_t, 5> squares{};  // by CellClass
   std::array<std::size_t, 3> cells{};    // U, E, O
   std::size_t groups_4x4 = 0;
+  std::size_t groups_8x8 = 0;
 };
 
 class Walk {
@@ -52,6 +53,7 @@ class Walk {
       return;
     }
     if (l == 2 && ScanClassifier::fewSectors(info)) expect4x4(ix0, iy0, info);
+    if (l == 3 && ScanClassifier::fewSectors(info)) expect8x8(ix0, iy0, info);
     const std::int64_t half = std::int64_t{1} << (l - 1);
     for (int q = 0; q < 4; ++q) {
       const std::int64_t cx = ix0 + ((q & 1) ? half : 0), cy = iy0 + ((q & 2) ? half : 0);
@@ -78,7 +80,20 @@ class Walk {
 
   void expect4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
     ++seen_->groups_4x4;
-    const CellMasks m = cls_.classify4x4(ix0, iy0, info);
+    expectGroup(ix0, iy0, cls_.classify4x4(ix0, iy0, info));
+  }
+
+  // classify8x8: its four groups, each against the reference (as the walk hands them to the
+  // level-2 children).
+  void expect8x8(std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
+    ++seen_->groups_8x8;
+    const std::array<CellMasks, 4> m = cls_.classify8x8(ix0, iy0, info);
+    for (std::size_t q = 0; q < 4; ++q) {
+      expectGroup(ix0 + ((q & 1) ? 4 : 0), iy0 + ((q & 2) ? 4 : 0), m[q]);
+    }
+  }
+
+  void expectGroup(std::int64_t ix0, std::int64_t iy0, const CellMasks& m) {
     for (unsigned i = 0; i < 16; ++i) {
       const std::int64_t x = ix0 + (i & 3), y = iy0 + (i >> 2);
       const CellClass want = ref_.cellClass(x, y);
@@ -140,6 +155,7 @@ void expectEveryClassSeen(const Seen& seen, const std::string& what) {
   EXPECT_GT(seen.cells[1], 0u) << what;
   EXPECT_GT(seen.cells[2], 0u) << what;
   EXPECT_GT(seen.groups_4x4, 0u) << what;
+  EXPECT_GT(seen.groups_8x8, 0u) << what;
 }
 
 TEST(ScanClassifier, RandomScansMatchTheCellByCellReference) {
