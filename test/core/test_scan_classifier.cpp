@@ -1,7 +1,7 @@
 // The scan classifier alone, without a map, against the dense reference's cell-by-cell model:
 // every cell's class exact, every square's class conservative (E only if all its cells are E, U
-// only if all are U, FREE_OR_UNKNOWN only without O), the 4 x 4 groups exact, on seeded random
-// scans with every kind of bad beam (NaN, +-inf, 0, below range_min, beyond range_max).
+// only if all are U, FREE_OR_UNKNOWN only without O), the 4 x 4 and 8 x 8 groups exact, on seeded
+// random scans with every kind of bad beam (NaN, +-inf, 0, below range_min, beyond range_max).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -29,6 +29,7 @@ struct Seen {
   std::array<std::size_t, 5> squares{};  // by CellClass
   std::array<std::size_t, 3> cells{};    // U, E, O
   std::size_t groups_4x4 = 0;
+  std::size_t groups_8x8 = 0;
 };
 
 class Walk {
@@ -52,6 +53,7 @@ class Walk {
       return;
     }
     if (l == 2 && ScanClassifier::fewSectors(info)) expect4x4(ix0, iy0, info);
+    if (l == 3 && ScanClassifier::fewSectors(info)) expect8x8(ix0, iy0, info);
     const std::int64_t half = std::int64_t{1} << (l - 1);
     for (int q = 0; q < 4; ++q) {
       const std::int64_t cx = ix0 + ((q & 1) ? half : 0), cy = iy0 + ((q & 2) ? half : 0);
@@ -78,7 +80,20 @@ class Walk {
 
   void expect4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
     ++seen_->groups_4x4;
-    const CellMasks m = cls_.classify4x4(ix0, iy0, info);
+    expectGroup(ix0, iy0, cls_.classify4x4(ix0, iy0, info));
+  }
+
+  // classify8x8: its four groups, each against the reference (as the walk hands them to the
+  // level-2 children).
+  void expect8x8(std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
+    ++seen_->groups_8x8;
+    const std::array<CellMasks, 4> m = cls_.classify8x8(ix0, iy0, info);
+    for (std::size_t q = 0; q < 4; ++q) {
+      expectGroup(ix0 + ((q & 1) ? 4 : 0), iy0 + ((q & 2) ? 4 : 0), m[q]);
+    }
+  }
+
+  void expectGroup(std::int64_t ix0, std::int64_t iy0, const CellMasks& m) {
     for (unsigned i = 0; i < 16; ++i) {
       const std::int64_t x = ix0 + (i & 3), y = iy0 + (i >> 2);
       const CellClass want = ref_.cellClass(x, y);
@@ -140,6 +155,7 @@ void expectEveryClassSeen(const Seen& seen, const std::string& what) {
   EXPECT_GT(seen.cells[1], 0u) << what;
   EXPECT_GT(seen.cells[2], 0u) << what;
   EXPECT_GT(seen.groups_4x4, 0u) << what;
+  EXPECT_GT(seen.groups_8x8, 0u) << what;
 }
 
 TEST(ScanClassifier, RandomScansMatchTheCellByCellReference) {
@@ -280,3 +296,28 @@ TEST(PreparedScan, HitCellsAreTheReferencesAtCellEdges) {
 
 }  // namespace
 }  // namespace wavog_test
+
+// The SSE2 quotient of a 4 x 4 group's buckets is the scalar expression, bit for bit, including
+// quotients just below and above an integer and the table mask's wrap.
+TEST(ScanNumerics, QuotientBucketsAreTheScalarQuotient) {
+  std::mt19937 rng(3401u);
+  std::uniform_real_distribution<double> term(-3.0, 3.0), den(0.5, 4.0);
+  const std::uint32_t mask = 1023u;
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::array<double, 4> nc, nr, dc, dr;
+    for (std::size_t i = 0; i < 4; ++i) {
+      dc[i] = den(rng);
+      dr[i] = den(rng);
+      nc[i] = 256.0 * (dc[i] + term(rng));
+      nr[i] = 256.0 * dr[i];
+    }
+    if (trial % 7 == 0) nc[1] = 300.0 * (dc[1] + dr[2]) - nr[2];  // an exact integer quotient
+    std::array<std::uint32_t, 16> got{};
+    wavog::detail::quotientBuckets16(nc.data(), nr.data(), dc.data(), dr.data(), mask, got.data());
+    for (std::size_t i = 0; i < 16; ++i) {
+      const double v = (nc[i & 3] + nr[i >> 2]) / (dc[i & 3] + dr[i >> 2]);
+      ASSERT_EQ(got[i], static_cast<std::uint32_t>(static_cast<std::int32_t>(v)) & mask)
+          << "trial " << trial << " cell " << i << " quotient " << v;
+    }
+  }
+}

@@ -60,6 +60,12 @@ class ScanClassifier {
   /// classifyCell() for the 16 cells of the 4 x 4 square at (ix0, iy0) classified as `square`
   /// (fewSectors(square)), as masks: bit x + 4 y for cell (ix0 + x, iy0 + y).
   CellMasks classify4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& square) const;
+  /// classify4x4() for the four 4 x 4 groups of the 8 x 8 square at (ix0, iy0) classified as
+  /// `square` (fewSectors(square)): group q (x offset 4 (q & 1), y offset 4 (q >> 1)) at [q], as
+  /// classify4x4() gives it. The work per group (offsets, quadrant, coefficients, the hits of the
+  /// square's beams) is done once for the 64 cells.
+  std::array<CellMasks, 4> classify8x8(std::int64_t ix0, std::int64_t iy0,
+                                       const SquareInfo& square) const;
 
   static constexpr int kFewSectors = 32;
 
@@ -71,9 +77,15 @@ class ScanClassifier {
 
   CellClass cellAt(std::size_t j, double d2) const;
   bool isHitCell(std::int64_t ix, std::int64_t iy, const SquareInfo& box) const;
-  std::uint32_t hitMask4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const;
-  bool quadrantBuckets(const std::array<double, 4>& dx, const std::array<double, 4>& dy,
-                       std::uint32_t* bucket) const;
+  template <std::size_t kSide>
+  void classifyGroups(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box,
+                      CellMasks* out) const;
+  template <std::size_t kGroups>
+  void hitMasks(const std::uint32_t* keys, const SquareInfo& box, std::uint32_t* hit) const;
+  template <std::size_t kSide>
+  bool quadrantCoeffs(const std::array<double, kSide>& dx, const std::array<double, kSide>& dy,
+                      std::array<double, kSide>* dc, std::array<double, kSide>* dr,
+                      std::array<double, kSide>* nc, std::array<double, kSide>* nr) const;
   long beamOf(double dx, double dy) const;
   long sectorIn(double dx, double dy, const SquareInfo& box, int start) const;
   int lastSurelyPast(double dx, double dy, double tol, int lo, int hi) const;

@@ -71,129 +71,175 @@ inline bool ScanClassifier::isHitCell(std::int64_t ix, std::int64_t iy,
   return false;
 }
 
-/// The cells of the 4 x 4 square at (ix0, iy0) (a multiple of 4 each) holding a hit endpoint of
-/// the square's beams: a compare and a mask per beam, without a branch (vectorised).
-[[gnu::always_inline]] inline std::uint32_t ScanClassifier::hitMask4x4(
-    std::int64_t ix0, std::int64_t iy0, const SquareInfo& box) const {
-  const std::uint32_t key = s_.groupKey(ix0, iy0);
+/// The cells holding a hit endpoint of the square's beams in each of kGroups 4 x 4 groups (group
+/// keys `keys`, PreparedScan::groupKey): a compare and a mask per beam and group, without a
+/// branch (vectorised).
+template <std::size_t kGroups>
+[[gnu::always_inline]] inline void ScanClassifier::hitMasks(const std::uint32_t* keys,
+                                                            const SquareInfo& box,
+                                                            std::uint32_t* hit) const {
   const std::uint32_t* group = s_.hit_group.data();
   const std::uint32_t* bit = s_.hit_bit.data();
-  std::uint32_t hit = 0;
+  for (std::size_t g = 0; g < kGroups; ++g) hit[g] = 0;
   for (int j = box.jlo; j <= box.jhi; ++j) {
     const auto ju = static_cast<std::size_t>(j);
-    hit |= group[ju] == key ? bit[ju] : 0u;
+    const std::uint32_t gj = group[ju], bj = bit[ju];
+    for (std::size_t g = 0; g < kGroups; ++g) hit[g] |= gj == keys[g] ? bj : 0u;
   }
-  return hit;
 }
 
-/// Distances are separable over the grid's 4 columns and 4 rows; every cell finds its sector in
-/// the pseudo-bearing table (exact, no trigonometry), and only a cell in a bucket near a boundary
-/// (about one in 10-20) tests the boundaries (sectorIn). The loops over the 16 cells are
-/// branch-free; the hits of the square's beams are gathered once.
 inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
                                              const SquareInfo& box) const {
+  CellMasks m;
+  classifyGroups<4>(ix0, iy0, box, &m);
+  return m;
+}
+
+inline std::array<CellMasks, 4> ScanClassifier::classify8x8(std::int64_t ix0, std::int64_t iy0,
+                                                            const SquareInfo& box) const {
+  std::array<CellMasks, 4> m;
+  classifyGroups<8>(ix0, iy0, box, m.data());
+  return m;
+}
+
+/// The 4 x 4 groups of the kSide x kSide square at (ix0, iy0) (a multiple of 4 each), group
+/// (gx, gy) at out[gx + gy kSide / 4]. Distances are separable over the square's columns and rows;
+/// every cell finds its sector in the pseudo-bearing table (exact, no trigonometry), and only a
+/// cell in a bucket near a boundary (about one in 10-20) tests the boundaries (sectorIn). The
+/// loops over a group's 16 cells are branch-free; the hits of the square's beams are gathered
+/// once, and the columns' and rows' terms are computed once for all groups.
+template <std::size_t kSide>
+[[gnu::always_inline]] inline void ScanClassifier::classifyGroups(std::int64_t ix0,
+                                                                  std::int64_t iy0,
+                                                                  const SquareInfo& box,
+                                                                  CellMasks* out) const {
+  constexpr std::size_t kPerRow = kSide / 4, kGroups = kPerRow * kPerRow;
   // The reference's arithmetic: dx = (ix + 1/2) res - px, d2 = dx dx + dy dy.
   // (x0 + i) + 1/2 = x0 + (i + 1/2) exactly (cell indices are far below 2^51): one conversion.
   const double x0 = static_cast<double>(ix0), y0 = static_cast<double>(iy0);
-  std::array<double, 4> dx, dy, dx2, dy2;
-  for (std::size_t i = 0; i < 4; ++i) {
+  std::array<double, kSide> dx, dy, dx2, dy2;
+  for (std::size_t i = 0; i < kSide; ++i) {
     const double half = static_cast<double>(i) + 0.5;
     dx[i] = (x0 + half) * s_.res - s_.px;
     dy[i] = (y0 + half) * s_.res - s_.py;
     dx2[i] = dx[i] * dx[i];
     dy2[i] = dy[i] * dy[i];
   }
-  std::array<double, 16> d2;
-  for (std::size_t i = 0; i < 16; ++i) d2[i] = dx2[i & 3] + dy2[i >> 2];
-  const std::uint32_t hit = hitMask4x4(ix0, iy0, box);
-  CellMasks m;
+  std::array<std::uint32_t, kGroups> keys, hit;
+  for (std::size_t g = 0; g < kGroups; ++g) {
+    keys[g] = s_.groupKey(ix0 + static_cast<std::int64_t>(4 * (g % kPerRow)),
+                          iy0 + static_cast<std::int64_t>(4 * (g / kPerRow)));
+  }
+  hitMasks<kGroups>(keys.data(), box, hit.data());
+  const auto finish = [&](std::size_t g, const double* te, const double* to) {
+    const double* gx2 = dx2.data() + 4 * (g % kPerRow);
+    const double* gy2 = dy2.data() + 4 * (g / kPerRow);
+    std::array<double, 16> d2;
+    for (std::size_t i = 0; i < 16; ++i) d2[i] = gx2[i & 3] + gy2[i >> 2];
+    const std::uint32_t e = compareMask16<true>(d2.data(), te);
+    const std::uint32_t o = compareMask16<false>(d2.data(), to);
+    out[g].e = e & ~hit[g];
+    out[g].o = (o & ~e) | hit[g];
+  };
   if (box.single) {  // one beam: distances alone
     const LeafTest t = s_.leaf[static_cast<std::size_t>(box.jlo)];
     std::array<double, 16> te, to;
     te.fill(t.e);
     to.fill(t.o);
-    const std::uint32_t e = compareMask16<true>(d2.data(), te.data());
-    const std::uint32_t o = compareMask16<false>(d2.data(), to.data());
-    m.e = e & ~hit;
-    m.o = (o & ~e) | hit;
-    return m;
+    for (std::size_t g = 0; g < kGroups; ++g) finish(g, te.data(), to.data());
+    return;
   }
   // Each cell's sector (n: outside the fan) from its bucket, or kUnsure.
   const SectorTable& table = s_.sectors;
-  std::array<std::uint32_t, 16> bucket;
-  if (!quadrantBuckets(dx, dy, bucket.data())) {
-    // The sensor-frame offsets are separable too.
-    std::array<double, 4> cx, sx, cy, sy;
-    for (std::size_t i = 0; i < 4; ++i) {
+  std::array<double, kSide> dc, dr, nc, nr;  // by the quotient, when the signs allow
+  std::array<double, kSide> cx, sx, cy, sy;  // else the sensor-frame offsets, separable too
+  const bool quotient = quadrantCoeffs<kSide>(dx, dy, &dc, &dr, &nc, &nr);
+  if (!quotient) {
+    for (std::size_t i = 0; i < kSide; ++i) {
       cx[i] = s_.cos_theta * dx[i];
       sx[i] = s_.sin_theta * dx[i];
       cy[i] = s_.cos_theta * dy[i];
       sy[i] = s_.sin_theta * dy[i];
     }
-    for (std::size_t i = 0; i < 16; ++i) {
-      bucket[i] = table.bucket(cx[i & 3] + sy[i >> 2], cy[i >> 2] - sx[i & 3]);
-    }
   }
-  std::array<std::int32_t, 16> sector;
   const std::int32_t* sectors = table.data();
-  for (std::size_t i = 0; i < 16; ++i) sector[i] = sectors[bucket[i]];
-  for (std::uint32_t unsure = negativeMask16(sector.data()) & ~hit; unsure != 0;
-       unsure &= unsure - 1) {
-    const auto i = static_cast<unsigned>(__builtin_ctz(unsure));
-    // Start from the sector of the bucket before (this one is near a boundary).
-    const long j = sectorIn(dx[i & 3], dy[i >> 2], box, sectors[(bucket[i] - 1u) & table.mask()]);
-    sector[i] = j < 0 || j >= s_.n ? s_.n : static_cast<std::int32_t>(j);
-  }
-  // The leaf tests of each cell's beam (leaf[n]: never E, never O; a hit cell's is not used).
-  std::array<double, 16> te, to;
   const LeafTest* leaf = s_.leaf.data();
-  for (std::size_t i = 0; i < 16; ++i) {
-    const LeafTest& t = leaf[static_cast<std::size_t>(std::max(sector[i], 0))];
-    te[i] = t.e;
-    to[i] = t.o;
+  const std::uint32_t mask = table.mask();
+  for (std::size_t g = 0; g < kGroups; ++g) {
+    const std::size_t ox = 4 * (g % kPerRow), oy = 4 * (g / kPerRow);
+    std::array<std::uint32_t, 16> bucket;
+    if (quotient) {
+      std::array<double, 4> gdc, gdr, gnc, gnr;  // the group's columns and rows
+      for (std::size_t i = 0; i < 4; ++i) {
+        gdc[i] = dc[ox + i];
+        gdr[i] = dr[oy + i];
+        gnc[i] = nc[ox + i];
+        gnr[i] = nr[oy + i];
+      }
+      quotientBuckets16(gnc.data(), gnr.data(), gdc.data(), gdr.data(), mask, bucket.data());
+    } else {
+      const double *gcx = cx.data() + ox, *gsx = sx.data() + ox;
+      const double *gcy = cy.data() + oy, *gsy = sy.data() + oy;
+      for (std::size_t i = 0; i < 16; ++i) {
+        bucket[i] = table.bucket(gcx[i & 3] + gsy[i >> 2], gcy[i >> 2] - gsx[i & 3]);
+      }
+    }
+    std::array<std::int32_t, 16> sector;
+    for (std::size_t i = 0; i < 16; ++i) sector[i] = sectors[bucket[i]];
+    for (std::uint32_t unsure = negativeMask16(sector.data()) & ~hit[g]; unsure != 0;
+         unsure &= unsure - 1) {
+      const auto i = static_cast<unsigned>(__builtin_ctz(unsure));
+      // Start from the sector of the bucket before (this one is near a boundary).
+      const long j = sectorIn(dx[ox + (i & 3)], dy[oy + (i >> 2)], box,
+                              sectors[(bucket[i] - 1u) & table.mask()]);
+      sector[i] = j < 0 || j >= s_.n ? s_.n : static_cast<std::int32_t>(j);
+    }
+    // The leaf tests of each cell's beam (leaf[n]: never E, never O; a hit cell's is not used).
+    std::array<double, 16> te, to;
+    for (std::size_t i = 0; i < 16; ++i) {
+      const LeafTest& t = leaf[static_cast<std::size_t>(std::max(sector[i], 0))];
+      te[i] = t.e;
+      to[i] = t.o;
+    }
+    finish(g, te.data(), to.data());
   }
-  const std::uint32_t e = compareMask16<true>(d2.data(), te.data());
-  const std::uint32_t o = compareMask16<false>(d2.data(), to.data());
-  m.e = e & ~hit;
-  m.o = (o & ~e) | hit;
-  return m;
 }
 
-/// The table buckets of the 16 cells of a 4 x 4 group whose sensor-frame offsets
-/// (X, Y) = (c dx + s dy, c dy - s dx) keep their signs a, b over the group, if they do (else
-/// false). There the pseudo-bearing times the table's scale is ((3 + a) scale D + a scale Y) / D
-/// with D = |X| + |Y| = aX + bY: numerator and denominator are a multiple of dx plus a multiple
-/// of dy (coefficients per scan and sign pair), so a cell costs two additions, a division and a
-/// conversion, without selects (vectorised). X and Y are linear over the group, so their extremes
-/// over it are sums of the extremes of their dx and dy terms; a group within 1e-12 (|dx| + |dy|)
-/// of an axis (far above the rounding of X and Y) is left to SectorTable::bucket. The quotient
-/// differs from pseudoBearing() scale by under 1e-13 scale (a few ulps on terms of at most
-/// 7 scale |d|, over D >= |d|), far inside the table's margin, which its sure buckets allow for.
-inline bool ScanClassifier::quadrantBuckets(const std::array<double, 4>& dx,
-                                            const std::array<double, 4>& dy,
-                                            std::uint32_t* bucket) const {
+/// The quotient's coefficient terms of the columns (dc, nc) and rows (dr, nr) of a square of
+/// cells whose sensor-frame offsets (X, Y) = (c dx + s dy, c dy - s dx) keep their signs a, b
+/// over the square, if they do (else false). There the pseudo-bearing times the table's scale is
+/// ((3 + a) scale D + a scale Y) / D with D = |X| + |Y| = aX + bY: numerator and denominator are
+/// a multiple of dx plus a multiple of dy (coefficients per scan and sign pair), so a cell costs
+/// two additions, a division and a conversion, without selects (vectorised). X and Y are linear
+/// over the square, so their extremes over it are sums of the extremes of their dx and dy terms;
+/// a square within 1e-12 (|dx| + |dy|) of an axis (far above the rounding of X and Y) is left to
+/// SectorTable::bucket. The quotient differs from pseudoBearing() scale by under 1e-13 scale (a
+/// few ulps on terms of at most 7 scale |d|, over D >= |d|), far inside the table's margin, which
+/// its sure buckets allow for.
+template <std::size_t kSide>
+inline bool ScanClassifier::quadrantCoeffs(const std::array<double, kSide>& dx,
+                                           const std::array<double, kSide>& dy,
+                                           std::array<double, kSide>* dc,
+                                           std::array<double, kSide>* dr,
+                                           std::array<double, kSide>* nc,
+                                           std::array<double, kSide>* nr) const {
+  constexpr std::size_t kLast = kSide - 1;
   const double c = s_.cos_theta, sn = s_.sin_theta;
-  const double cx0 = c * dx[0], cx3 = c * dx[3], sx0 = sn * dx[0], sx3 = sn * dx[3];
-  const double cy0 = c * dy[0], cy3 = c * dy[3], sy0 = sn * dy[0], sy3 = sn * dy[3];
+  const double cx0 = c * dx[0], cx3 = c * dx[kLast], sx0 = sn * dx[0], sx3 = sn * dx[kLast];
+  const double cy0 = c * dy[0], cy3 = c * dy[kLast], sy0 = sn * dy[0], sy3 = sn * dy[kLast];
   const double x_lo = std::min(cx0, cx3) + std::min(sy0, sy3);
   const double x_hi = std::max(cx0, cx3) + std::max(sy0, sy3);
   const double y_lo = std::min(cy0, cy3) - std::max(sx0, sx3);
   const double y_hi = std::max(cy0, cy3) - std::min(sx0, sx3);
-  const double tiny = 1e-12 * (std::max(std::fabs(dx[0]), std::fabs(dx[3])) +
-                               std::max(std::fabs(dy[0]), std::fabs(dy[3])));
+  const double tiny = 1e-12 * (std::max(std::fabs(dx[0]), std::fabs(dx[kLast])) +
+                               std::max(std::fabs(dy[0]), std::fabs(dy[kLast])));
   if (!(x_lo > tiny || x_hi < -tiny) || !(y_lo > tiny || y_hi < -tiny)) return false;
   const QuadrantCoeffs& k = quadrant_[(x_lo > 0.0 ? 0u : 1u) | (y_lo > 0.0 ? 0u : 2u)];
-  std::array<double, 4> dc, dr, nc, nr;
-  for (std::size_t i = 0; i < 4; ++i) {
-    dc[i] = k.dx * dx[i];
-    dr[i] = k.dy * dy[i];
-    nc[i] = k.nx * dx[i];
-    nr[i] = k.ny * dy[i];
-  }
-  const std::uint32_t mask = s_.sectors.mask();
-  for (std::size_t i = 0; i < 16; ++i) {
-    const double v = (nc[i & 3] + nr[i >> 2]) / (dc[i & 3] + dr[i >> 2]);  // in [1, 5] scale
-    bucket[i] = static_cast<std::uint32_t>(static_cast<std::int32_t>(v)) & mask;
+  for (std::size_t i = 0; i < kSide; ++i) {
+    (*dc)[i] = k.dx * dx[i];
+    (*dr)[i] = k.dy * dy[i];
+    (*nc)[i] = k.nx * dx[i];
+    (*nr)[i] = k.ny * dy[i];
   }
   return true;
 }

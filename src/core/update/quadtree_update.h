@@ -274,7 +274,10 @@ class Integrator {
     // The children are read after the (long) classification: fetch them meanwhile.
     if (n.children != 0) impl_.pool.prefetch(n.children);
     if (l == 1) return visitLeafParent(n, box, ix0, iy0, s);
-    if (l == 2 && ScanClassifier::fewSectors(box)) return visitLevel2(n, box, ix0, iy0, s);
+    if (l == 2 && ScanClassifier::fewSectors(box)) {
+      return visitGroup(n, box, cls_.classify4x4(ix0, iy0, box), s, ix0, iy0);
+    }
+    if (l == 3 && ScanClassifier::fewSectors(box)) return visitLevel3(n, box, ix0, iy0, s);
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     Spans parts{};
@@ -349,13 +352,46 @@ class Integrator {
     return foldChanges(n, delta);
   }
 
-  // A level-2 node (4 x 4 finest cells, tag flushed): its 16 cells are classified together
-  // (cheaply when the square lies in one or a few sectors) and each level-1 child slot takes the
-  // class of its 4 cells, exactly, instead of a conservative square test of its own.
-  [[gnu::noinline]] double visitLevel2(Node& n, const SquareInfo& box, std::int64_t ix0,
+  // A level-3 node (8 x 8 finest cells, tag flushed) whose cells lie in one or a few sectors:
+  // its 64 cells are classified in one pass (classify8x8: the work per group shared), and each
+  // level-2 child slot takes the exact class of its 16 cells instead of a conservative square test
+  // of its own (fewer children refined: a square test can say MIXED of all-E or all-U cells), and
+  // is updated from them (visitGroup). A child that the square test would have skipped has its
+  // cells classified for nothing; on fr079 the sum still pays (docs/compare.md).
+  [[gnu::noinline]] double visitLevel3(Node& n, const SquareInfo& box, std::int64_t ix0,
                                        std::int64_t iy0, double s) {
-    [[maybe_unused]] const std::uint32_t code = slot_code_;   // kHits: its first cell
-    const CellMasks cells = cls_.classify4x4(ix0, iy0, box);  // cell (x, y) at bit x + 4 y
+    [[maybe_unused]] const std::uint32_t code = slot_code_;  // kHits: its first cell
+    const std::array<CellMasks, 4> groups = cls_.classify8x8(ix0, iy0, box);
+    const std::array<double, 4> c = haar::backward(s, n.d);
+    std::array<double, 4> delta{};
+    Spans parts{};
+    if constexpr (kNdt) slot_span_.split(3, parts.data());
+    for (int q = 0; q < 4; ++q) {
+      const auto qu = static_cast<std::size_t>(q);
+      ++visited_;
+      const CellClass cq = groupClass(groups[qu]);
+      if (cq == CellClass::kUnknown) continue;
+      const std::int64_t cx = ix0 + ((q & 1) ? 4 : 0), cy = iy0 + ((q & 2) ? 4 : 0);
+      ChildSlot slot(impl_, store_, n, q);
+      if constexpr (kNdt) enterSlot(parts[qu], box);
+      if constexpr (kHits) enterCells(code + (static_cast<std::uint32_t>(q) << 4));
+      delta[qu] = updateSlot(slot, cq, c[qu], [&](Node& m) {
+        ++visited_;
+        impl_.flush(m);
+        if (m.children != 0) impl_.pool.prefetch(m.children);
+        return visitGroup(m, box, groups[qu], c[qu], cx, cy);
+      });
+    }
+    return foldChanges(n, delta);
+  }
+
+  // A level-2 node (4 x 4 finest cells, tag flushed) whose 16 cells have the classes `cells`
+  // (classified together, cheaply when the square lies in one or a few sectors; cell (x, y) at
+  // bit x + 4 y): each level-1 child slot takes the class of its 4 cells, exactly, instead of a
+  // conservative square test of its own.
+  [[gnu::noinline]] double visitGroup(Node& n, const SquareInfo& box, const CellMasks& cells,
+                                      double s, std::int64_t ix0, std::int64_t iy0) {
+    [[maybe_unused]] const std::uint32_t code = slot_code_;  // kHits: its first cell
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     Spans parts{};
@@ -378,6 +414,13 @@ class Integrator {
       });
     }
     return foldChanges(n, delta);
+  }
+
+  // The exact class of a 4 x 4 square from its cells' classes.
+  static CellClass groupClass(const CellMasks& cc) {
+    if (cc.o != 0) return CellClass::kMixed;
+    if (cc.e == 0xFFFFu) return CellClass::kEmpty;
+    return cc.e == 0 ? CellClass::kUnknown : CellClass::kFreeOrUnknown;
   }
 
   // Bits 0, 1, 4, 5 of a 4 x 4 mask (a 2 x 2 corner) as bits 0..3.
