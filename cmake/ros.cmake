@@ -10,7 +10,7 @@ target_include_directories(wavog_ros_includes SYSTEM INTERFACE ${catkin_INCLUDE_
                            ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})
 
 # ---- wavog_ros_config: the one parameter loader (node, nodelet and offline tools) -------------
-add_library(wavog_ros_config src/ros/config.cpp)
+add_library(wavog_ros_config src/ros/config.cpp src/ros/config_validate.cpp)
 target_link_libraries(wavog_ros_config PUBLIC wavog_ros_includes wavog_core ${catkin_LIBRARIES} PRIVATE yaml-cpp)
 target_compile_options(wavog_ros_config PRIVATE ${WAVOG_WARNINGS})
 set_target_properties(wavog_ros_config PROPERTIES POSITION_INDEPENDENT_CODE ON)
