@@ -10,10 +10,7 @@
 
 namespace wavog {
 namespace detail {
-namespace {
 
-// The reasons the core refuses a whole scan, or kOk (the extent is checked once the reach is
-// known, in prepare()).
 ScanStatus checkScan(const Pose2& pose, const ScanView& scan) {
   if (scan.count == 0 || scan.ranges == nullptr) return ScanStatus::kEmpty;
   const double n_beams = static_cast<double>(scan.count);
@@ -31,23 +28,22 @@ ScanStatus checkScan(const Pose2& pose, const ScanView& scan) {
   return ScanStatus::kOk;
 }
 
-}  // namespace
+bool reachInExtent(const Pose2& pose, const BeamLimits& limits, double resolution) {
+  const double max_reach = std::max(limits.sensor_max + limits.half_band, limits.clear);
+  const double extent = static_cast<double>(kCellIndexLimit) - 2.0;
+  return (std::fabs(pose.x) + max_reach) / resolution < extent &&
+         (std::fabs(pose.y) + max_reach) / resolution < extent;
+}
 
 ScanStatus PreparedScan::prepare(const MapParams& params, const Pose2& pose, const ScanView& scan,
                                  IntegrateStats* st) {
   const ScanStatus status = checkScan(pose, scan);
   if (status != ScanStatus::kOk) return status;
   const BeamLimits limits = beamLimits(params, scan);
-  // Every cell the scan may touch (hit cells, the reach box, the block loop) lies within
-  // max_reach of the pose: inside the extent, each of them is an exact int64 (no cast overflows)
-  // and a distinct 32-bit block key. Two cells of margin for the floors and the band rounding.
-  const double max_reach = std::max(limits.sensor_max + limits.half_band, limits.clear);
+  // Every cell the scan may touch (hit cells, the reach box, the block loop) lies within the
+  // largest reach of the pose.
+  if (!reachInExtent(pose, limits, params.grid.resolution)) return ScanStatus::kOutOfExtent;
   const double cell = params.grid.resolution;
-  const double extent = static_cast<double>(kCellIndexLimit) - 2.0;
-  if (!((std::fabs(pose.x) + max_reach) / cell < extent) ||
-      !((std::fabs(pose.y) + max_reach) / cell < extent)) {
-    return ScanStatus::kOutOfExtent;
-  }
   setGeometry(pose, scan, cell);
   setBoundaries();
   sectors.prepare(n, amin, inc);
@@ -110,7 +106,7 @@ void PreparedScan::setBoundaries() {
   }
 }
 
-PreparedScan::BeamLimits PreparedScan::beamLimits(const MapParams& params, const ScanView& scan) {
+BeamLimits beamLimits(const MapParams& params, const ScanView& scan) {
   // The hard limit caps range_max (+inf is allowed by REP 117) and no_return_clear, so one scan's
   // reach, and with it the blocks and cells it may touch, is bounded (limits.h).
   const double hard = hardRangeLimit(params.grid, scan.count);

@@ -31,6 +31,22 @@ struct LeafTest {
   double o = -1.0;
 };
 
+/// The reasons the core refuses a whole scan before its reach is known (kEmpty, kBadGeometry,
+/// kBadPose), or kOk. The extent is checked with the reach (reachInExtent).
+ScanStatus checkScan(const Pose2& pose, const ScanView& scan);
+
+/// The range limits of one scan's beams (m): no return at or beyond sensor_max, the given
+/// limit (min of range_max and max_range) capped, like the no-return clearing distance, by the
+/// hard limit (limits.h).
+struct BeamLimits {
+  double given = 0, sensor_max = 0, clear = 0, half_band = 0;
+};
+BeamLimits beamLimits(const MapParams& params, const ScanView& scan);
+
+/// Whether every cell within the largest reach `limits` allow of `pose` lies inside the extent
+/// (two cells of margin), so that each is an exact int64 and a distinct 32-bit block key.
+bool reachInExtent(const Pose2& pose, const BeamLimits& limits, double resolution);
+
 /// One scan, ready for classification. Beams are reordered by ascending bearing (inc > 0).
 struct PreparedScan {
   /// Validates `scan` and `pose` and fills every field (buffers are reused between scans).
@@ -132,13 +148,6 @@ struct PreparedScan {
   static constexpr std::size_t kKeepBuckets = 8192;
   void setGeometry(const Pose2& pose, const ScanView& scan, double res);
   void setBoundaries();
-  /// The range limits of one scan's beams (m): no return at or beyond sensor_max, the given
-  /// limit (min of range_max and max_range) capped, like the no-return clearing distance, by the
-  /// hard limit (limits.h).
-  struct BeamLimits {
-    double given = 0, sensor_max = 0, clear = 0, half_band = 0;
-  };
-  static BeamLimits beamLimits(const MapParams& params, const ScanView& scan);
   void setBeams(const BeamLimits& limits, const ScanView& scan, IntegrateStats* st);
   /// The beams' sensor-frame unit vectors, kept while the geometry (n, amin, inc) is.
   void setUnits();

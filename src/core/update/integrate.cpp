@@ -16,7 +16,6 @@
 #include "update/block_update.h"
 #include "storage/map_impl.h"
 #include "classify/scan_classifier.h"
-#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
@@ -71,32 +70,12 @@ CellBox regionBlocks(const WaveletMap::Impl& impl, const detail::PreparedScan& p
 // the valid beams: a return's z + half band, a no-return's clear distance). Any doubt: false, and
 // the scan is prepared, refused or tested exactly as in a map of every block.
 bool surelyOutsideRegion(const MapParams& p, const Pose2& pose, const ScanView& scan) {
-  constexpr double kTwoPiSlack = 2.0 * 3.14159265358979323846 + 1e-6;
-  if (scan.count == 0 || scan.ranges == nullptr || scan.count > kMaxBeams) return false;
-  const double n_beams = static_cast<double>(scan.count);
-  if (!(std::fabs(scan.angle_min) <= kMaxAbsAngleMin) ||
-      !(std::fabs(scan.angle_increment) >= kMinAbsAngleIncrement) ||
-      !std::isfinite(scan.angle_increment) || !std::isfinite(scan.range_min) ||
-      scan.range_min < 0.0 || !(scan.range_max > scan.range_min) || std::isnan(scan.range_max) ||
-      std::fabs(scan.angle_increment) * n_beams > kTwoPiSlack) {
-    return false;
-  }
-  if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
-    return false;
-  }
-  const double hard = hardRangeLimit(p.grid, scan.count);
-  const double given =
-      p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max) : scan.range_max;
-  const double sensor_max = std::min(given, hard);
-  const double clear = std::min(p.sensor.no_return_clear, hard);
-  const double half_band =
-      0.5 * (p.sensor.band_width > 0 ? p.sensor.band_width : p.grid.resolution);
-  const double max_reach = std::max(sensor_max + half_band, clear);
-  const double extent = static_cast<double>(kCellIndexLimit) - 4.0;
-  if (!((std::fabs(pose.x) + max_reach) / p.grid.resolution < extent) ||
-      !((std::fabs(pose.y) + max_reach) / p.grid.resolution < extent)) {
-    return false;
-  }
+  if (detail::checkScan(pose, scan) != ScanStatus::kOk) return false;
+  const detail::BeamLimits limits = detail::beamLimits(p, scan);
+  if (!detail::reachInExtent(pose, limits, p.grid.resolution)) return false;
+  const double sensor_max = limits.sensor_max;
+  const double clear = limits.clear;
+  const double half_band = limits.half_band;
   // The farthest a valid beam reaches, and whether there is one (returns: finite, > 0, at least
   // range_min and below sensor_max; no-returns: at or beyond sensor_max, valid when clear > 0).
   double far = 0.0;
