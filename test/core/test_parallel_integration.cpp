@@ -93,32 +93,10 @@ class ThreadRun {
   std::vector<std::unique_ptr<WaveletMap>> maps_;
 };
 
+// Every policy and prior, forgetting eager and pruned, and the payloads: reflection layers and
+// normal-distribution cells (saved in the file) and forgetting in seconds.
 std::vector<NamedParams> configurations(double res, int block_levels) {
-  auto out = everyPolicy(res, block_levels);
-  for (const auto& base : everyPolicy(res, block_levels)) {
-    if (base.name != "forget") continue;
-    NamedParams eager = base;
-    eager.name = "forget_eager";
-    eager.params.lazy_forgetting = false;
-    out.push_back(eager);
-    NamedParams pruned = base;
-    pruned.name = "forget_pruned_skip";
-    pruned.params.prune_threshold = 0.05;
-    pruned.params.skip_tolerance = 0.01;
-    out.push_back(pruned);
-  }
-  // The payloads: reflection layers and normal-distribution cells (saved in the file) and
-  // forgetting in seconds.
-  for (const auto& base : everyPolicy(res, block_levels)) {
-    if (base.name != "forget" && base.name != "none" && base.name != "max") continue;
-    NamedParams reflection = base;
-    reflection.name = base.name + "_reflection_ndt";
-    reflection.params.reflection = true;
-    reflection.params.ndt = true;
-    if (base.name == "forget") reflection.params.policy.forget_half_life = 0.2;
-    out.push_back(reflection);
-  }
-  return out;
+  return everyPolicyWithVariants(res, block_levels, {"forget", "none", "max"});
 }
 
 TEST(ParallelIntegration, RandomScansGiveTheSameMapForOneTwoAndFourThreads) {

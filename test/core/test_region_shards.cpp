@@ -36,32 +36,7 @@ BlockRegion region(std::int64_t min_bx, std::int64_t min_by, std::int64_t max_bx
 // The configurations: every policy and prior, forgetting eager and pruned, and the payloads
 // (reflection layers and Gaussians, forgetting in seconds).
 std::vector<NamedParams> configurations(double res, int levels) {
-  auto out = everyPolicy(res, levels);
-  for (const auto& base : everyPolicy(res, levels)) {
-    if (base.name != "forget") continue;
-    NamedParams eager = base;
-    eager.name = "forget_eager";
-    eager.params.lazy_forgetting = false;
-    out.push_back(eager);
-    NamedParams pruned = base;
-    pruned.name = "forget_pruned_skip";
-    pruned.params.prune_threshold = 0.05;
-    pruned.params.skip_tolerance = 0.01;
-    out.push_back(pruned);
-  }
-  for (const auto& base : everyPolicy(res, levels)) {
-    if (base.name != "forget" && base.name != "none" && base.name != "max" &&
-        base.name != "clamp") {
-      continue;
-    }
-    NamedParams payloads = base;
-    payloads.name = base.name + "_reflection_ndt";
-    payloads.params.reflection = true;
-    payloads.params.ndt = true;
-    if (base.name == "forget") payloads.params.policy.forget_half_life = 0.2;
-    out.push_back(payloads);
-  }
-  return out;
+  return everyPolicyWithVariants(res, levels, {"forget", "none", "max", "clamp"});
 }
 
 // The cells of `r` at scale s (s <= block_levels, so a scale-s cell lies in one block).

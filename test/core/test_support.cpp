@@ -38,6 +38,36 @@ std::vector<NamedParams> everyPolicy(double resolution, int block_levels) {
   return out;
 }
 
+std::vector<NamedParams> everyPolicyWithVariants(double resolution, int block_levels,
+                                                 const std::vector<std::string>& payload_policies) {
+  auto out = everyPolicy(resolution, block_levels);
+  for (const auto& base : everyPolicy(resolution, block_levels)) {
+    if (base.name != "forget") continue;
+    NamedParams eager = base;
+    eager.name = "forget_eager";
+    eager.params.lazy_forgetting = false;
+    out.push_back(eager);
+    NamedParams pruned = base;
+    pruned.name = "forget_pruned_skip";
+    pruned.params.prune_threshold = 0.05;
+    pruned.params.skip_tolerance = 0.01;
+    out.push_back(pruned);
+  }
+  for (const auto& base : everyPolicy(resolution, block_levels)) {
+    if (std::find(payload_policies.begin(), payload_policies.end(), base.name) ==
+        payload_policies.end()) {
+      continue;
+    }
+    NamedParams payloads = base;
+    payloads.name = base.name + "_reflection_ndt";
+    payloads.params.reflection = true;
+    payloads.params.ndt = true;
+    if (base.name == "forget") payloads.params.policy.forget_half_life = 0.2;
+    out.push_back(payloads);
+  }
+  return out;
+}
+
 std::vector<PolicyType> everyPolicyType() {
   return {PolicyType::kNone,   PolicyType::kMax,        PolicyType::kClamp,
           PolicyType::kForget, PolicyType::kClampLower, PolicyType::kClampUpper};

@@ -20,6 +20,12 @@ struct NamedParams {
   wavog::MapParams params;
 };
 std::vector<NamedParams> everyPolicy(double resolution, int block_levels);
+/// everyPolicy(), then forget eager ("forget_eager") and pruned with skipping
+/// ("forget_pruned_skip"), then, for each configuration of everyPolicy() (in its order) named in
+/// `payload_policies`, one with the payloads: reflection layers and normal-distribution cells
+/// ("<name>_reflection_ndt"; forget then in seconds, half-life 0.2 s).
+std::vector<NamedParams> everyPolicyWithVariants(double resolution, int block_levels,
+                                                 const std::vector<std::string>& payload_policies);
 /// The six policies, in PolicyType's order.
 std::vector<wavog::PolicyType> everyPolicyType();
 

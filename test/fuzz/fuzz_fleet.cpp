@@ -32,7 +32,9 @@
 namespace {
 
 using wavog_fuzz::hostileDouble;
+using wavog_fuzz::hostileNsec;
 using wavog_fuzz::hostileRange;
+using wavog_fuzz::hostileSec;
 using Msg = std::shared_ptr<const wavog_mapping::PlacedScan>;
 
 constexpr std::size_t kMaxMessages = 8;
@@ -51,19 +53,6 @@ struct Vehicle {
   std::uint64_t regressions = 0, jumps = 0;
 };
 
-std::uint32_t hostileSec(FuzzedDataProvider* in) {
-  switch (in->ConsumeIntegralInRange<int>(0, 3)) {
-    case 0:
-      return 4294967295u;
-    case 1:
-      return in->ConsumeIntegral<std::uint32_t>();
-    case 2:
-      return 0u;
-    default:
-      return 1700000000u + in->ConsumeIntegralInRange<std::uint32_t>(0, 100);
-  }
-}
-
 // A stamp near the fleet clock (most messages pass the stamp check) or a hostile one.
 ros::Time decodeStamp(FuzzedDataProvider* in, const ros::Time& now) {
   ros::Time t;
@@ -71,8 +60,7 @@ ros::Time decodeStamp(FuzzedDataProvider* in, const ros::Time& now) {
     if (wavog_ros::addSeconds(now, hostileDouble(in, -2.0, 2.0), &t)) return t;
   }
   t.sec = hostileSec(in);
-  t.nsec = in->ConsumeBool() ? in->ConsumeIntegral<std::uint32_t>()
-                             : in->ConsumeIntegralInRange<std::uint32_t>(0, 999999999u);
+  t.nsec = hostileNsec(in);
   return t;
 }
 

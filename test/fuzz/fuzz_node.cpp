@@ -26,31 +26,15 @@
 namespace {
 
 using wavog_fuzz::hostileDouble;
+using wavog_fuzz::hostileNsec;
 using wavog_fuzz::hostileRange;
+using wavog_fuzz::hostileSec;
 
 constexpr std::size_t kMaxBeams = 720;
 /// Read-outs above this many cells are only sized, not filled (instrumented fill loops).
 constexpr double kReadOutCells = 1 << 16;
 
 const char* const kFrames[] = {"laser", "map", "", "/laser", "other"};
-
-std::uint32_t hostileSec(FuzzedDataProvider* in) {
-  switch (in->ConsumeIntegralInRange<int>(0, 3)) {
-    case 0:
-      return 4294967295u;
-    case 1:
-      return in->ConsumeIntegral<std::uint32_t>();
-    case 2:
-      return 0u;
-    default:
-      return 1700000000u + in->ConsumeIntegralInRange<std::uint32_t>(0, 100);
-  }
-}
-
-std::uint32_t hostileNsec(FuzzedDataProvider* in) {
-  return in->ConsumeBool() ? in->ConsumeIntegral<std::uint32_t>()
-                           : in->ConsumeIntegralInRange<std::uint32_t>(0, 999999999u);
-}
 
 sensor_msgs::LaserScan decodeScan(FuzzedDataProvider* in) {
   sensor_msgs::LaserScan s;

@@ -345,6 +345,26 @@ inline float hostileRange(FuzzedDataProvider* in, float hi) {
   }
 }
 
+/// A stamp's seconds: 2^32 - 1, any value, 0, or a recent date (2023).
+inline std::uint32_t hostileSec(FuzzedDataProvider* in) {
+  switch (in->ConsumeIntegralInRange<int>(0, 3)) {
+    case 0:
+      return 4294967295u;
+    case 1:
+      return in->ConsumeIntegral<std::uint32_t>();
+    case 2:
+      return 0u;
+    default:
+      return 1700000000u + in->ConsumeIntegralInRange<std::uint32_t>(0, 100);
+  }
+}
+
+/// A stamp's nanoseconds: any value (also >= 1e9, which ROS refuses) or a valid one.
+inline std::uint32_t hostileNsec(FuzzedDataProvider* in) {
+  return in->ConsumeBool() ? in->ConsumeIntegral<std::uint32_t>()
+                           : in->ConsumeIntegralInRange<std::uint32_t>(0, 999999999u);
+}
+
 }  // namespace wavog_fuzz
 
 #endif  // WAVOG_MAPPING_TEST_FUZZ_FUZZ_SUPPORT_H_

@@ -12,31 +12,15 @@
 #include "fleet/intake.h"
 #include "fleet/placed_scan.h"
 #include "fleet/stream_index.h"
+#include "placed_scan_fixture.h"
 
 namespace {
 
+using placed_scan_fixture::goodScan;
 using wavog_fleet::IndexStep;
 using wavog_fleet::Refusal;
 
-const ros::Time kNow(100.0);
-
-wavog_mapping::PlacedScan goodScan(std::uint64_t index, bool codes = false) {
-  const std::vector<float> ranges(181, 5.0f);
-  wavog::ScanView view;
-  view.ranges = ranges.data();
-  view.count = ranges.size();
-  view.angle_min = -M_PI / 2;
-  view.angle_increment = M_PI / 180;
-  view.range_min = 0.1;
-  view.range_max = 80.0;
-  wavog_mapping::PlacedScan m;
-  wavog_fleet::RangeCodec codec;
-  if (codes) EXPECT_TRUE(codec.encode(view, wavog::MapParams{}));
-  wavog_fleet::fillPlacedScan(kNow, "map", "v1", "/v1/scan", index, wavog::Pose2{1, 2, 0.5}, view,
-                              false, wavog::Pose2{1, 2, 0.5}, wavog::Pose2{1, 2, 0.5}, &m,
-                              codes ? &codec : nullptr);
-  return m;
-}
+const ros::Time kNow(100.0);  // the fleet clock, goodScan()'s stamp
 
 struct Stream {
   wavog_fleet::StreamIndex index;

@@ -17,6 +17,7 @@
 
 #include "fleet/placed_scan.h"
 #include "fleet/reorder_buffer.h"
+#include "placed_scan_fixture.h"
 #include "wavog_mapping/core/scan_period.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/sim/laser_sim.h"
@@ -114,20 +115,7 @@ TEST(ReorderBuffer, RefusesBeyondItsCapacity) {
 
 // ---- foreign input -----------------------------------------------------------------------------
 
-wavog_mapping::PlacedScan goodScan() {
-  const std::vector<float> ranges(181, 5.0f);
-  wavog::ScanView view;
-  view.ranges = ranges.data();
-  view.count = ranges.size();
-  view.angle_min = -M_PI / 2;
-  view.angle_increment = M_PI / 180;
-  view.range_min = 0.1;
-  view.range_max = 80.0;
-  wavog_mapping::PlacedScan m;
-  wavog_fleet::fillPlacedScan(ros::Time(100.0), "map", "v1", "/v1/scan", 0, wavog::Pose2{1, 2, 0.5},
-                              view, false, wavog::Pose2{1, 2, 0.5}, wavog::Pose2{1, 2, 0.5}, &m);
-  return m;
-}
+using placed_scan_fixture::goodScan;
 
 Refusal check(const wavog_mapping::PlacedScan& m) {
   std::string detail;
