@@ -19,7 +19,7 @@ import subprocess
 import sys
 import time
 
-from fleet_common import cpu_seconds, free_port, stop_all, wait_for_master
+from fleet_common import RosGraph, cpu_seconds, stop_all
 
 BIN, SRC, OUT = sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3])
 DURATION = float(sys.argv[4]) if len(sys.argv) > 4 else 20.0
@@ -29,28 +29,11 @@ VEHICLES = ["v%d" % (k + 1) for k in range(N)]
 RECORD_RATE = 0.5
 
 
-class Graph:
+class Graph(RosGraph):
     """A private roscore and the processes started under it."""
 
     def __init__(self):
-        self.env = dict(os.environ)
-        self.env["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % free_port()
-        self.env["ROS_HOSTNAME"] = "127.0.0.1"
-        self.env.pop("ROS_IP", None)
-        self.procs = []
-        self.start(["roscore", "-p", self.env["ROS_MASTER_URI"].rsplit(":", 1)[1]])
-        os.environ.update(self.env)
-        wait_for_master("/fleet_bench")
-        self.param("set", "/use_sim_time", "true")
-
-    def param(self, *args):
-        subprocess.run(["rosparam"] + list(args), env=self.env, check=True)
-
-    def start(self, args):
-        p = subprocess.Popen(args, env=self.env, stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL)
-        self.procs.append(p)
-        return p
+        super().__init__("/fleet_bench")
 
     def wait_for(self, topic_or_service, service=True, timeout=30.0):
         import rosgraph

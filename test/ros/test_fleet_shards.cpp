@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "fleet_test_support.h"
 #include "wavog_mapping/FleetStatus.h"
 #include "wavog_mapping/PlacedScan.h"
 #include "wavog_mapping/SaveMap.h"
@@ -38,31 +39,8 @@ constexpr double kDuration = 5.0;  // s of each vehicle's drive
 const std::vector<std::string> kNodes = {"/all", "/shard_a", "/shard_b"};
 constexpr double kFarEast = 1000.0;  // m: v4 is v1 this far east
 
-/// Starts `args` with ROS_HOSTNAME `host` (no ROS_IP, see test/fleet.test).
-pid_t spawn(const std::vector<std::string>& args, const std::string& host) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    unsetenv("ROS_IP");
-    setenv("ROS_HOSTNAME", host.c_str(), 1);
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execvp(argv[0], argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-void stop(pid_t pid) {
-  if (pid <= 0) return;
-  kill(pid, SIGINT);
-  for (int i = 0; i < 100; ++i) {
-    if (waitpid(pid, nullptr, WNOHANG) == pid) return;
-    usleep(100000);
-  }
-  kill(pid, SIGKILL);
-  waitpid(pid, nullptr, 0);
-}
+using fleet_test::spawn;  // every child here gets a host of its own (a loopback address)
+using fleet_test::stop;
 
 /// One placed scan as a mapper streams it (fleet_stream.cpp fills the same fields).
 struct Streamed {

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "fleet/placed_scan.h"
+#include "fleet_test_support.h"
 #include "wavog_mapping/FleetStatus.h"
 #include "wavog_mapping/PlacedScan.h"
 #include "wavog_mapping/SaveMap.h"
@@ -49,39 +50,9 @@ const std::map<std::string, std::string> kHosts = {{"/wavog_fleet", "127.0.0.2"}
                                                    {"/v3/wavog_mapping", "127.0.0.5"}};
 constexpr const char* kTestHost = "127.0.0.6";
 
-/// Starts `args`; `host` non-empty: the child's ROS_HOSTNAME (and no ROS_IP: roscpp listens on
-/// 127.0.0.1 only when ROS_IP is 127.*).
-pid_t spawn(const std::vector<std::string>& args, const std::string& host = "") {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    if (!host.empty()) {
-      unsetenv("ROS_IP");
-      setenv("ROS_HOSTNAME", host.c_str(), 1);
-    }
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execvp(argv[0], argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-bool exited(pid_t pid) {
-  int status = 0;
-  return waitpid(pid, &status, WNOHANG) == pid;
-}
-
-void stop(pid_t pid) {
-  if (pid <= 0) return;
-  kill(pid, SIGINT);
-  for (int i = 0; i < 100; ++i) {
-    if (exited(pid)) return;
-    usleep(100000);
-  }
-  kill(pid, SIGKILL);
-  waitpid(pid, nullptr, 0);
-}
+using fleet_test::exited;
+using fleet_test::spawn;
+using fleet_test::stop;
 
 /// Stops a child at the end of the test, also when an assertion returns early (a child left
 /// running would hold the test's output pipe open).
