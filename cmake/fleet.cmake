@@ -25,7 +25,8 @@ set_target_properties(wavog_fleet PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # wavog_site: the shards' coarse layers put together (issue 36).
-add_executable(wavog_site src/ros/fleet/site_node.cpp src/ros/fleet/site_layers.cpp)
+add_executable(wavog_site src/ros/fleet/site_node.cpp src/ros/fleet/site_layers.cpp
+  src/ros/fleet/site_vehicles.cpp)
 target_link_libraries(wavog_site PRIVATE ${catkin_LIBRARIES})
 target_include_directories(wavog_site SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_compile_options(wavog_site PRIVATE ${WAVOG_WARNINGS})
@@ -48,6 +49,16 @@ if(CATKIN_ENABLE_TESTING)
   if(TARGET test_range_codec)
     target_include_directories(test_range_codec PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
     target_link_libraries(test_range_codec wavog_ros ${GTEST_MAIN_LIBRARIES})
+  endif()
+  # The site node's parts (issue 36): layers put together, hostile layers refused; the vehicles
+  # outside every region.
+  catkin_add_gtest(test_site_layers test/ros/test_site_layers.cpp src/ros/fleet/site_layers.cpp
+    src/ros/fleet/site_vehicles.cpp)
+  if(TARGET test_site_layers)
+    target_include_directories(test_site_layers PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
+    target_include_directories(test_site_layers SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+    target_link_libraries(test_site_layers ${catkin_LIBRARIES} ${GTEST_MAIN_LIBRARIES})
+    add_dependencies(test_site_layers ${PROJECT_NAME}_generate_messages_cpp)
   endif()
   # A vehicle's intake (issue 37): counters, refusals, the index sequence.
   catkin_add_gtest(test_fleet_intake test/ros/test_fleet_intake.cpp)

@@ -7,6 +7,7 @@
 // map_scale_3; a fourth vehicle 1 km east of the car park, outside every region, is counted by
 // each shard (outside_region) and mapped by none (only by the unsharded node); a shard restarted
 // from its own ~save_map holds that map exactly. Prints the bytes of a vehicle's window.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -20,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -114,6 +116,25 @@ struct Latest {
   }
 };
 
+/// wavog_site's latest "site" status in /diagnostics, as key -> value.
+struct SiteDiagnostics {
+  std::mutex mutex;
+  std::map<std::string, std::string> values;
+  void operator()(const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+    for (const auto& st : m->status) {
+      if (st.name.find("wavog_site") == std::string::npos) continue;
+      std::lock_guard<std::mutex> lock(mutex);
+      values.clear();
+      for (const auto& kv : st.values) values[kv.key] = kv.value;
+    }
+  }
+  std::string get(const std::string& key) {
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = values.find(key);
+    return it == values.end() ? std::string("(none)") : it->second;
+  }
+};
+
 bool saveMap(const std::string& service, const std::string& path) {
   wavog_mapping::SaveMap srv;
   srv.request.path = path;
@@ -157,8 +178,8 @@ std::pair<std::size_t, std::size_t> gridDiff(const nav_msgs::OccupancyGrid& a,
 
 TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   ros::NodeHandle nh;
-  wavog_ros::Config config =
-      wavog_ros::loadConfigFile(std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_shard.yaml", nullptr);
+  wavog_ros::Config config = wavog_ros::loadConfigFile(
+      std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_shard.yaml", nullptr);
   const std::vector<Streamed> scans = fleetScans(3);
   ASSERT_GT(scans.size(), 1500u);
   std::size_t v4_scans = 0;
@@ -166,8 +187,8 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
 
   std::vector<ros::Publisher> pubs;
   for (int k = 1; k <= 4; ++k) {
-    pubs.push_back(nh.advertise<wavog_mapping::PlacedScan>("/v" + std::to_string(k) +
-                                                           "/fleet_scans", 5000));
+    pubs.push_back(
+        nh.advertise<wavog_mapping::PlacedScan>("/v" + std::to_string(k) + "/fleet_scans", 5000));
   }
   Latest<wavog_mapping::FleetStatus> status[3];
   std::vector<ros::Subscriber> subs;
@@ -186,6 +207,9 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   subs.push_back(nh.subscribe<nav_msgs::OccupancyGrid>("/v1/fleet_map", 2, boost::ref(window)));
   subs.push_back(nh.subscribe<map_msgs::OccupancyGridUpdate>("/v1/fleet_map_updates", 100,
                                                              boost::ref(window_update)));
+  SiteDiagnostics site_diag;
+  subs.push_back(
+      nh.subscribe<diagnostic_msgs::DiagnosticArray>("/diagnostics", 50, boost::ref(site_diag)));
   ros::AsyncSpinner spinner(2);
   spinner.start();
 
@@ -243,6 +267,21 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   }
   ASSERT_EQ(status[0].get()->vehicles.size(), 4u);
 
+  // wavog_site's site-wide figures: v4 outside every region, all its scans mapped by no shard,
+  // no layer refused.
+  const std::string v4_count = std::to_string(v4_scans);
+  const ros::WallTime diag_until = ros::WallTime::now() + ros::WallDuration(10.0);
+  while (ros::WallTime::now() < diag_until &&
+         site_diag.get("scans mapped by no shard (at most)") != v4_count) {
+    ros::WallDuration(0.2).sleep();
+  }
+  EXPECT_EQ(site_diag.get("scans mapped by no shard (at most)"), v4_count);
+  EXPECT_EQ(site_diag.get("vehicles outside every region"), "1");
+  EXPECT_EQ(site_diag.get("outside every region"), "/v4");
+  EXPECT_EQ(site_diag.get("layers refused: bad layer"), "0");
+  EXPECT_EQ(site_diag.get("layers refused: shards disagree"), "0");
+  EXPECT_EQ(site_diag.get("layers refused: over max_cells"), "0");
+
   // ---- the shard rule: the saved maps, as floats, every cell at every scale.
   const std::string stem = "/tmp/wavog_fleet_shards_" + std::to_string(getpid());
   wavog::MapParams params = config.map;
@@ -259,8 +298,7 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   // The regions' union, blocks [-10, 22) x [-10, 16) (fleet_shards.test); v4's cells lie east of
   // it, in the unsharded map only.
   for (int s = 0; s <= L; ++s) {
-    const wavog::CellBox box{-10LL << (L - s), -10LL << (L - s), 22LL << (L - s),
-                             16LL << (L - s)};
+    const wavog::CellBox box{-10LL << (L - s), -10LL << (L - s), 22LL << (L - s), 16LL << (L - s)};
     const wavog::Raster w = whole.exportScale(s, box, wavog::Aggregation::kMean);
     const wavog::Raster a = maps[1].exportScale(s, box, wavog::Aggregation::kMean);
     const wavog::Raster b = maps[2].exportScale(s, box, wavog::Aggregation::kMean);
@@ -284,7 +322,8 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   const wavog::CellBox east = whole.boxAround(kFarEast - 5.0, 0.0, kFarEast + 75.0, 34.0, 0);
   EXPECT_GT(whole.exportScale(0, east, wavog::Aggregation::kMean).log_odds.size(), 0u);
   std::size_t east_known = 0;
-  for (std::uint8_t k : whole.exportScale(0, east, wavog::Aggregation::kMean).known) east_known += k;
+  for (std::uint8_t k : whole.exportScale(0, east, wavog::Aggregation::kMean).known)
+    east_known += k;
   EXPECT_GT(east_known, 10000u);
   wavog::CellBox shard_box;
   for (int i = 1; i <= 2; ++i) {
@@ -324,20 +363,21 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   EXPECT_EQ(scale_differ, 0u) << "of " << scale->data.size();
   EXPECT_GT(site_known, 1000u);
   EXPECT_EQ(site_known, scale_known);
-  std::printf("window /v1/fleet_map: %u x %u cells, %zu messages %zu bytes; updates %zu messages "
-              "%zu bytes; streamed %zu scans in %.1f s\n",
-              win->info.width, win->info.height, window.count, window.bytes, window_update.count,
-              window_update.bytes, scans.size(), kDuration);
+  std::printf(
+      "window /v1/fleet_map: %u x %u cells, %zu messages %zu bytes; updates %zu messages "
+      "%zu bytes; streamed %zu scans in %.1f s\n",
+      win->info.width, win->info.height, window.count, window.bytes, window_update.count,
+      window_update.bytes, scans.size(), kDuration);
   EXPECT_GT(window_update.count, 0u);
 
   // ---- a shard restarts and catches up from its own ~save_map (map_file): its map is that map,
   // cell for cell, before any scan reaches it.
   {
     const std::string saved = stem + "shard_b.wmap";
-    const pid_t loader = spawn({"rosparam", "load",
-                                std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_shard.yaml",
-                                "/restarted/wavog_fleet"},
-                               "127.0.0.6");
+    const pid_t loader =
+        spawn({"rosparam", "load", std::string(WAVOG_SOURCE_DIR) + "/test/ros/fleet_shard.yaml",
+               "/restarted/wavog_fleet"},
+              "127.0.0.6");
     int code = -1;
     ASSERT_EQ(waitpid(loader, &code, 0), loader);
     ASSERT_TRUE(WIFEXITED(code) && WEXITSTATUS(code) == 0);

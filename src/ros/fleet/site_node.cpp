@@ -2,20 +2,23 @@
 // <shard>/map_scale_<s> of every shard in ~shards and every scale in ~scales, and publishes their
 // union as site_map_scale_<s> (latched; site_layers.h) at ~rate Hz when a shard's layer changed,
 // so that a dispatcher sees the whole site without the fine grid of all of it. It also follows
-// each shard's <shard>/wavog_fleet/fleet_status and warns (throttled, per vehicle) about a vehicle
-// whose latest scan reached no shard's region: outside every region, its scans are mapped by no
-// shard (each shard counts them, VehicleStatus.outside_region). Bad parameters
-// fail at start-up, naming the parameter; layers that do not fit together are warned (throttled)
-// and not published.
+// each shard's <shard>/wavog_fleet/fleet_status (site_vehicles.h) and warns (throttled, per
+// vehicle) about a vehicle whose latest scan reached no shard's region: outside every region, its
+// scans are mapped by no shard. Bad parameters fail at start-up, naming the parameter and its
+// range; layers that cannot be put together are refused (counted by reason, warned with a
+// throttle, not published). Counters and the vehicles outside every region go to /diagnostics.
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 
+#include <cstdint>
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "site_layers.h"
+#include "site_vehicles.h"
 #include "wavog_mapping/FleetStatus.h"
 
 namespace {
@@ -26,6 +29,13 @@ struct Scale {
   std::vector<ros::Subscriber> subs;
   std::vector<nav_msgs::OccupancyGrid::ConstPtr> latest;  ///< per shard
   bool changed = false;
+  std::uint64_t published = 0;
+};
+
+// Refusals by reason, over every scale.
+struct Refusals {
+  std::uint64_t bad_layer = 0, mismatch = 0, too_large = 0;
+  std::string last;  ///< the latest refusal's text
 };
 
 [[noreturn]] void fail(const std::string& text) {
@@ -41,13 +51,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> shards;
   std::vector<int> scales;
   double rate = 1.0;
+  std::uint64_t max_cells = wavog_fleet::kDefaultMaxSiteCells;
   try {
     if (!pnh.getParam("shards", shards) || shards.empty()) {
       fail("~shards must list the shards' namespaces (at least one)");
     }
     if (!pnh.getParam("scales", scales) || scales.empty()) {
-      fail("~scales must list the scales to assemble (each in [1, 12], published by every shard "
-           "in publish_scales)");
+      fail(
+          "~scales must list the scales to assemble (each in [1, 12], published by every shard "
+          "in publish_scales)");
     }
     for (int s : scales) {
       if (s < 1 || s > 12) fail("~scales entry (" + std::to_string(s) + ") must be in [1, 12]");
@@ -56,6 +68,13 @@ int main(int argc, char** argv) {
     if (!(rate > 0.0 && rate <= 100.0)) {
       fail("~rate (" + std::to_string(rate) + ") must be in (0, 100] Hz");
     }
+    double cells = static_cast<double>(max_cells);
+    pnh.param("max_cells", cells, cells);
+    if (!(cells >= 1.0 && cells <= static_cast<double>(wavog_fleet::kMaxSiteCellsLimit))) {
+      fail("~max_cells (" + std::to_string(cells) + ") must be in [1, " +
+           std::to_string(wavog_fleet::kMaxSiteCellsLimit) + "] cells per site layer");
+    }
+    max_cells = static_cast<std::uint64_t>(cells);
   } catch (const std::invalid_argument&) {
     return 1;
   }
@@ -66,8 +85,7 @@ int main(int argc, char** argv) {
     l.latest.resize(shards.size());
     l.pub = nh.advertise<nav_msgs::OccupancyGrid>("site_map_scale_" + std::to_string(s), 1, true);
     for (std::size_t i = 0; i < shards.size(); ++i) {
-      const std::string topic =
-          ros::names::append(shards[i], "map_scale_" + std::to_string(s));
+      const std::string topic = ros::names::append(shards[i], "map_scale_" + std::to_string(s));
       l.subs.push_back(nh.subscribe<nav_msgs::OccupancyGrid>(
           topic, 2, [&l, i](const nav_msgs::OccupancyGrid::ConstPtr& m) {
             l.latest[i] = m;
@@ -83,48 +101,83 @@ int main(int argc, char** argv) {
         ros::names::append(shards[i], "wavog_fleet/fleet_status"), 2,
         [&statuses, i](const wavog_mapping::FleetStatus::ConstPtr& m) { statuses[i] = m; }));
   }
+
+  wavog_fleet::SiteVehicles site;
   std::map<std::string, ros::WallTime> warned;
-  ros::WallTimer status_timer = nh.createWallTimer(ros::WallDuration(1.0), [&](const ros::WallTimerEvent&) {
-    std::map<std::string, int> in, seen;
-    std::map<std::string, std::string> counts;
-    for (std::size_t i = 0; i < shards.size(); ++i) {
-      if (!statuses[i]) return;  // not every shard heard from yet
-      for (const auto& v : statuses[i]->vehicles) {
-        if (v.integrated == 0 || v.stale) continue;
-        ++seen[v.vehicle];
-        in[v.vehicle] += v.in_region ? 1 : 0;
-        counts[v.vehicle] += " " + shards[i] + ": " + std::to_string(v.outside_region);
-      }
+  ros::WallTimer status_timer =
+      nh.createWallTimer(ros::WallDuration(1.0), [&](const ros::WallTimerEvent&) {
+        site = wavog_fleet::summariseVehicles(statuses, shards);
+        const ros::WallTime now = ros::WallTime::now();
+        for (const auto& v : site.outside) {
+          auto it = warned.find(v.vehicle);
+          if (it != warned.end() && (now - it->second).toSec() < 5.0) continue;
+          warned[v.vehicle] = now;
+          ROS_WARN(
+              "wavog_site: vehicle '%s' is outside every region: its latest scan reached no "
+              "shard, its scans there are mapped by none (outside_region per shard:%s)",
+              v.vehicle.c_str(), v.per_shard.c_str());
+        }
+      });
+
+  Refusals refusals;
+  ros::WallTimer timer =
+      nh.createWallTimer(ros::WallDuration(1.0 / rate), [&](const ros::WallTimerEvent&) {
+        for (auto& kv : layers) {
+          Scale& l = kv.second;
+          if (!l.changed) continue;
+          l.changed = false;
+          std::vector<const nav_msgs::OccupancyGrid*> parts;
+          for (const auto& m : l.latest) parts.push_back(m.get());
+          nav_msgs::OccupancyGrid out;
+          std::string why;
+          const wavog_fleet::SiteRefusal r =
+              wavog_fleet::assembleSiteLayer(parts, max_cells, &out, &why);
+          if (r == wavog_fleet::SiteRefusal::kNone) {
+            l.pub.publish(out);
+            ++l.published;
+            continue;
+          }
+          if (r == wavog_fleet::SiteRefusal::kBadLayer) ++refusals.bad_layer;
+          if (r == wavog_fleet::SiteRefusal::kMismatch) ++refusals.mismatch;
+          if (r == wavog_fleet::SiteRefusal::kTooLarge) ++refusals.too_large;
+          if (r != wavog_fleet::SiteRefusal::kNothingKnown) {
+            refusals.last = "site_map_scale_" + std::to_string(l.scale) + ": " + why;
+          }
+          ROS_WARN_THROTTLE(5.0, "wavog_site: site_map_scale_%d not published: %s", l.scale,
+                            why.c_str());
+        }
+      });
+
+  diagnostic_updater::Updater updater(nh, pnh, pnh.getNamespace());
+  updater.setHardwareID("wavog_mapping");
+  updater.add("site", [&](diagnostic_updater::DiagnosticStatusWrapper& s) {
+    const std::uint64_t refused = refusals.bad_layer + refusals.mismatch + refusals.too_large;
+    if (refused > 0) {
+      s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "layers refused: " + refusals.last);
+    } else if (!site.outside.empty()) {
+      s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                std::to_string(site.outside.size()) + " vehicle(s) outside every region");
+    } else {
+      s.summary(diagnostic_msgs::DiagnosticStatus::OK, "assembling");
     }
-    const ros::WallTime now = ros::WallTime::now();
-    for (const auto& kv : seen) {
-      if (kv.second != static_cast<int>(shards.size()) || in[kv.first] > 0) continue;
-      auto it = warned.find(kv.first);
-      if (it != warned.end() && (now - it->second).toSec() < 5.0) continue;
-      warned[kv.first] = now;
-      ROS_WARN("wavog_site: vehicle '%s' is outside every region: its latest scan reached no "
-               "shard, its scans there are mapped by none (outside_region per shard:%s)",
-               kv.first.c_str(), counts[kv.first].c_str());
+    for (const auto& kv : layers) {
+      s.add("site_map_scale_" + std::to_string(kv.first) + " published", kv.second.published);
     }
+    s.add("layers refused: bad layer", refusals.bad_layer);
+    s.add("layers refused: shards disagree", refusals.mismatch);
+    s.add("layers refused: over max_cells", refusals.too_large);
+    s.add("every shard reported", site.complete);
+    s.add("vehicles outside every region", site.outside.size());
+    std::string names;
+    for (const auto& v : site.outside) names += (names.empty() ? "" : " ") + v.vehicle;
+    s.add("outside every region", names);
+    s.add("scans mapped by no shard (at most)", site.scans_mapped_by_none_max);
   });
-  ros::WallTimer timer = nh.createWallTimer(ros::WallDuration(1.0 / rate), [&](const ros::WallTimerEvent&) {
-    for (auto& kv : layers) {
-      Scale& l = kv.second;
-      if (!l.changed) continue;
-      l.changed = false;
-      std::vector<const nav_msgs::OccupancyGrid*> parts;
-      for (const auto& m : l.latest) parts.push_back(m.get());
-      nav_msgs::OccupancyGrid out;
-      std::string why;
-      if (!wavog_fleet::assembleSiteLayer(parts, &out, &why)) {
-        ROS_WARN_THROTTLE(5.0, "wavog_site: site_map_scale_%d not published: %s", l.scale,
-                          why.c_str());
-        continue;
-      }
-      l.pub.publish(out);
-    }
-  });
-  ROS_INFO("wavog_site: assembling %zu scales of %zu shards", layers.size(), shards.size());
+  ros::WallTimer diag_timer = nh.createWallTimer(
+      ros::WallDuration(1.0), [&](const ros::WallTimerEvent&) { updater.update(); });
+
+  ROS_INFO("wavog_site: assembling %zu scales of %zu shards (at most %llu cells a layer)",
+           layers.size(), shards.size(), static_cast<unsigned long long>(max_cells));
   ros::spin();
   return 0;
 }

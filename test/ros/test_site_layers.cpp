@@ -1,0 +1,191 @@
+// wavog_site's parts without a roscore (issue 36): the shards' layers put together cell for cell,
+// every malformed or hostile layer refused under its reason without writing outside the site grid
+// or allocating past ~max_cells, and the vehicles outside every region from the shards' statuses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "fleet/site_layers.h"
+#include "fleet/site_vehicles.h"
+
+namespace {
+
+using wavog_fleet::assembleSiteLayer;
+using wavog_fleet::kDefaultMaxSiteCells;
+using wavog_fleet::SiteRefusal;
+
+// A width x height layer at 0.8 m with its origin at cell (x0, y0), every cell `value`.
+nav_msgs::OccupancyGrid layer(std::int64_t x0, std::int64_t y0, std::uint32_t width,
+                              std::uint32_t height, std::int8_t value, double stamp = 10.0) {
+  nav_msgs::OccupancyGrid g;
+  g.header.frame_id = "map";
+  g.header.stamp = ros::Time(stamp);
+  g.info.resolution = 0.8f;
+  g.info.width = width;
+  g.info.height = height;
+  g.info.origin.position.x = static_cast<double>(x0) * 0.8f;
+  g.info.origin.position.y = static_cast<double>(y0) * 0.8f;
+  g.info.origin.orientation.w = 1.0;
+  g.data.assign(static_cast<std::size_t>(width) * height, value);
+  return g;
+}
+
+SiteRefusal assemble(const std::vector<const nav_msgs::OccupancyGrid*>& parts,
+                     nav_msgs::OccupancyGrid* out, std::uint64_t max_cells = kDefaultMaxSiteCells) {
+  std::string why;
+  const SiteRefusal r = assembleSiteLayer(parts, max_cells, out, &why);
+  EXPECT_EQ(r == SiteRefusal::kNone, why.empty()) << why;
+  if (r != SiteRefusal::kNone) {
+    EXPECT_TRUE(out->data.empty()) << why;
+    EXPECT_EQ(out->info.width, 0u) << why;
+  }
+  return r;
+}
+
+TEST(SiteLayers, PutsTheShardsKnownCellsOnOneGrid) {
+  nav_msgs::OccupancyGrid a = layer(-4, 2, 3, 2, 0, 12.0);
+  nav_msgs::OccupancyGrid b = layer(5, -1, 2, 2, 100, 11.0);
+  a.data[1] = -1;  // unknown in a shard stays unknown
+  nav_msgs::OccupancyGrid out;
+  ASSERT_EQ(assemble({&a, nullptr, &b}, &out), SiteRefusal::kNone);
+  EXPECT_EQ(out.info.width, 11u);  // cells -4 .. 6
+  EXPECT_EQ(out.info.height, 5u);  // cells -1 .. 3
+  EXPECT_DOUBLE_EQ(out.info.origin.position.x, -4 * 0.8f);
+  EXPECT_DOUBLE_EQ(out.info.origin.position.y, -1 * 0.8f);
+  EXPECT_EQ(out.header.stamp, ros::Time(11.0));  // the oldest part's
+  EXPECT_EQ(out.header.frame_id, "map");
+  int known_a = 0, known_b = 0;
+  for (std::uint32_t y = 0; y < out.info.height; ++y) {
+    for (std::uint32_t x = 0; x < out.info.width; ++x) {
+      const int cx = static_cast<int>(x) - 4, cy = static_cast<int>(y) - 1;
+      const std::int8_t v = out.data[y * out.info.width + x];
+      const bool in_a = cx >= -4 && cx < -1 && cy >= 2 && cy < 4 && !(cx == -3 && cy == 2);
+      const bool in_b = cx >= 5 && cx < 7 && cy >= -1 && cy < 1;
+      EXPECT_EQ(v, in_a ? 0 : in_b ? 100 : -1) << cx << "," << cy;
+      known_a += in_a;
+      known_b += in_b;
+    }
+  }
+  EXPECT_EQ(known_a, 5);
+  EXPECT_EQ(known_b, 4);
+}
+
+TEST(SiteLayers, NothingKnownUntilAShardPublishes) {
+  nav_msgs::OccupancyGrid empty = layer(0, 0, 0, 0, 0);
+  nav_msgs::OccupancyGrid out;
+  EXPECT_EQ(assemble({}, &out), SiteRefusal::kNothingKnown);
+  EXPECT_EQ(assemble({nullptr, &empty}, &out), SiteRefusal::kNothingKnown);
+}
+
+TEST(SiteLayers, RefusesASiteOverMaxCellsBeforeAllocating) {
+  // Two shards 2^33 cells apart: a grid of width 2^33 + 1 wraps a 32-bit width; before the check
+  // this wrote outside the site grid.
+  nav_msgs::OccupancyGrid a = layer(0, 0, 1, 1, 50);
+  nav_msgs::OccupancyGrid b = layer(std::int64_t{1} << 33, 0, 1, 1, 50);
+  nav_msgs::OccupancyGrid out;
+  EXPECT_EQ(assemble({&a, &b}, &out), SiteRefusal::kTooLarge);
+  nav_msgs::OccupancyGrid c = layer(0, std::int64_t{1} << 20, 1, 1, 50);
+  nav_msgs::OccupancyGrid d = layer(std::int64_t{1} << 20, 0, 1, 1, 50);
+  EXPECT_EQ(assemble({&a, &c, &d}, &out), SiteRefusal::kTooLarge);
+  // The limit itself: a 100 x 10 site fits 1,000 cells, not 999.
+  nav_msgs::OccupancyGrid e = layer(99, 9, 1, 1, 50);
+  EXPECT_EQ(assemble({&a, &e}, &out, 1000), SiteRefusal::kNone);
+  EXPECT_EQ(out.data.size(), 1000u);
+  EXPECT_EQ(assemble({&a, &e}, &out, 999), SiteRefusal::kTooLarge);
+}
+
+TEST(SiteLayers, RefusesMalformedLayers) {
+  nav_msgs::OccupancyGrid good = layer(0, 0, 2, 2, 0);
+  nav_msgs::OccupancyGrid out;
+  // Refused beside a good layer and alone (a layer in another frame is fine alone).
+  auto bad = [&](const nav_msgs::OccupancyGrid& g, SiteRefusal expected, const char* what,
+                 SiteRefusal alone) {
+    EXPECT_EQ(assemble({&good, &g}, &out), expected) << what;
+    EXPECT_EQ(assemble({&g}, &out), alone) << what << " alone";
+  };
+  nav_msgs::OccupancyGrid g = layer(3, 0, 2, 2, 0);
+  g.data.pop_back();
+  bad(g, SiteRefusal::kBadLayer, "data shorter than width x height", SiteRefusal::kBadLayer);
+  g = layer(3, 0, 2, 2, 0);
+  g.info.width = 0xffffffffu;
+  bad(g, SiteRefusal::kBadLayer, "width far beyond the data", SiteRefusal::kBadLayer);
+  for (float res : {0.0f, -0.8f, std::numeric_limits<float>::quiet_NaN(),
+                    std::numeric_limits<float>::infinity()}) {
+    g = layer(3, 0, 2, 2, 0);
+    g.info.resolution = res;
+    bad(g, SiteRefusal::kBadLayer, "resolution not a positive number", SiteRefusal::kBadLayer);
+  }
+  g = layer(3, 0, 2, 2, 0);
+  g.info.origin.orientation.z = std::sin(0.25);
+  g.info.origin.orientation.w = std::cos(0.25);
+  bad(g, SiteRefusal::kBadLayer, "rotated", SiteRefusal::kBadLayer);
+  for (std::int8_t v : {std::int8_t{101}, std::int8_t{-2}, std::int8_t{-128}, std::int8_t{127}}) {
+    g = layer(3, 0, 2, 2, 0);
+    g.data[3] = v;
+    bad(g, SiteRefusal::kBadLayer, "a value outside -1 and 0..100", SiteRefusal::kBadLayer);
+  }
+  for (double x : {0.4 * 0.8, std::numeric_limits<double>::quiet_NaN(),
+                   std::numeric_limits<double>::infinity(), 1e300, 0.8 * 2e12}) {
+    g = layer(3, 0, 2, 2, 0);
+    g.info.origin.position.x = x;
+    bad(g, SiteRefusal::kMismatch, "origin off the lattice or beyond 2^40 cells",
+        SiteRefusal::kMismatch);
+  }
+  g = layer(3, 0, 2, 2, 0);
+  g.header.frame_id = "odom";
+  bad(g, SiteRefusal::kMismatch, "another frame", SiteRefusal::kNone);
+  g = layer(3, 0, 2, 2, 0);
+  g.info.resolution = 0.4f;
+  g.info.origin.position.x = 3 * 0.4f;
+  EXPECT_EQ(assemble({&good, &g}, &out), SiteRefusal::kMismatch) << "another resolution";
+}
+
+// Statuses of shards, each listing vehicles.
+wavog_mapping::VehicleStatus vehicle(const std::string& name, bool in_region, std::uint64_t outside,
+                                     bool stale = false) {
+  wavog_mapping::VehicleStatus v;
+  v.vehicle = name;
+  v.integrated = 10;
+  v.in_region = in_region;
+  v.outside_region = outside;
+  v.stale = stale;
+  return v;
+}
+
+wavog_mapping::FleetStatus::ConstPtr status(std::vector<wavog_mapping::VehicleStatus> vehicles) {
+  wavog_mapping::FleetStatus::Ptr s(new wavog_mapping::FleetStatus);
+  s->vehicles = std::move(vehicles);
+  return s;
+}
+
+TEST(SiteVehicles, NamesVehiclesOutsideEveryRegionAndBoundsTheirScans) {
+  const std::vector<std::string> shards = {"/a", "/b"};
+  std::vector<wavog_mapping::FleetStatus::ConstPtr> st(2);
+  st[0] = status({vehicle("v1", true, 3), vehicle("v2", false, 40), vehicle("v3", false, 7)});
+  wavog_fleet::SiteVehicles site = wavog_fleet::summariseVehicles(st, shards);
+  EXPECT_FALSE(site.complete);  // /b not heard from
+  EXPECT_TRUE(site.outside.empty());
+
+  st[1] = status({vehicle("v1", false, 5), vehicle("v2", false, 38),
+                  vehicle("v3", false, 9, /*stale=*/true), vehicle("v4", false, 100)});
+  site = wavog_fleet::summariseVehicles(st, shards);
+  ASSERT_TRUE(site.complete);
+  ASSERT_EQ(site.outside.size(), 1u);  // v1 reached /a; v3 stale in /b; v4 unknown to /a
+  EXPECT_EQ(site.outside[0].vehicle, "v2");
+  EXPECT_EQ(site.outside[0].per_shard, " /a: 40 /b: 38");
+  EXPECT_EQ(site.scans_mapped_by_none_max, 3u + 38u + 7u);  // v1, v2, v3: the smaller count
+
+  st[0] = status({vehicle("v1", false, std::numeric_limits<std::uint64_t>::max()),
+                  vehicle("v2", false, std::numeric_limits<std::uint64_t>::max())});
+  st[1] = status({vehicle("v1", false, std::numeric_limits<std::uint64_t>::max()),
+                  vehicle("v2", false, std::numeric_limits<std::uint64_t>::max())});
+  site = wavog_fleet::summariseVehicles(st, shards);
+  EXPECT_EQ(site.scans_mapped_by_none_max, std::numeric_limits<std::uint64_t>::max());
+  EXPECT_EQ(site.outside.size(), 2u);
+}
+
+}  // namespace
