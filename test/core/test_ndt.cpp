@@ -446,7 +446,9 @@ TEST(Ndt, FilesOfFormatVersion2StillLoad) {
       // The file's hits and misses layers against today's hits with misses from the occupancy.
       const float a = loaded.reflection({x, y}), b = made.reflection({x, y});
       ASSERT_EQ(std::isnan(a), std::isnan(b));
-      if (!std::isnan(a)) ASSERT_NEAR(a, b, 1e-4);
+      if (!std::isnan(a)) {
+        ASSERT_NEAR(a, b, 1e-4);
+      }
       observed += made.isObserved({x, y}) ? 1 : 0;
     }
   }

@@ -262,7 +262,9 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
         EXPECT_EQ(v.outside_region, v4_scans) << kNodes[static_cast<std::size_t>(i)];
         EXPECT_FALSE(v.in_region);
       }
-      if (i == 0) EXPECT_EQ(v.outside_region, 0u);  // no region
+      if (i == 0) {
+        EXPECT_EQ(v.outside_region, 0u);  // no region
+      }
     }
   }
   ASSERT_EQ(status[0].get()->vehicles.size(), 4u);

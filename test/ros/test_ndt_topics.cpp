@@ -88,7 +88,9 @@ void checkMarkers(const visualization_msgs::MarkerArray& msg, int scale, double 
   }
   const std::size_t n = msg.markers.size() - 1;
   EXPECT_GE(on_wall, n * 7 / 10) << "of " << n;
-  if (scale == 0) EXPECT_GE(red, n * 9 / 10) << "of " << n << ": end-point cells are occupied";
+  if (scale == 0) {
+    EXPECT_GE(red, n * 9 / 10) << "of " << n << ": end-point cells are occupied";
+  }
   EXPECT_GT(long_along_x_wall, 0u);
   EXPECT_EQ(across_x_wall, 0u);
 }
