@@ -56,6 +56,12 @@ int main(int argc, char** argv) {
     if (!pnh.getParam("shards", shards) || shards.empty()) {
       fail("~shards must list the shards' namespaces (at least one)");
     }
+    for (const std::string& shard : shards) {
+      std::string error;
+      if (!ros::names::validate(shard, error)) {
+        fail("~shards entry '" + shard + "' is not a ROS namespace: " + error);
+      }
+    }
     if (!pnh.getParam("scales", scales) || scales.empty()) {
       fail(
           "~scales must list the scales to assemble (each in [1, 12], published by every shard "
