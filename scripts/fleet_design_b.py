@@ -28,21 +28,26 @@ VEHICLES = (sys.argv[5] if len(sys.argv) > 5 else "v1").split(",")
 PERIOD = float(sys.argv[6]) if len(sys.argv) > 6 else 0.5
 
 HEADER = 8 + 4 + 8 + 4 + 8 + 8  # magic, version, resolution, block_levels, prior, factor
-NODE = 3 * 4 + 2 + 1 + 1 + 1    # f32 dx dy dxy, u16 pending, u8 child_mask, known_all, known_any
+# Per node: dx dy dxy (f64 from version 6, f32 in 5), u16 pending, u8 child_mask, known_all,
+# known_any.
+DETAIL_BYTES = {5: 4, 6: 8}
 
 
 def blocks_of(path):
-    """{(bx, by): the block's bytes as the file encodes it} of a native map (version 5)."""
+    """{(bx, by): the block's bytes as the file encodes it} of a native map (version 5 or 6)."""
     with open(path, "rb") as f:
         data = f.read()
-    if data[:8] != b"WAVOGMAP" or struct.unpack_from("<I", data, 8)[0] != 5:
-        raise RuntimeError(path + ": not a version 5 native map")
+    version = struct.unpack_from("<I", data, 8)[0] if len(data) >= 12 else None
+    if data[:8] != b"WAVOGMAP" or version not in DETAIL_BYTES:
+        raise RuntimeError(path + ": not a version 5 or 6 native map")
+    details = 3 * DETAIL_BYTES[version]
+    NODE = details + 2 + 1 + 1 + 1
     levels = struct.unpack_from("<i", data, 20)[0]
     count = struct.unpack_from("<Q", data, HEADER)[0]
     at = HEADER + 8
 
     def node(at, level):
-        mask = data[at + 14]
+        mask = data[at + details + 2]
         at += NODE
         if level > 1:
             for q in range(4):
