@@ -26,6 +26,11 @@ def rss_bytes(pid):
     return 0
 
 
+def dropped_of(status):
+    """Every dropped_* counter of an InputStatus, whatever reasons the message has today."""
+    return sum(getattr(status, f) for f in status.__slots__ if f.startswith("dropped_"))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--pid", type=int, required=True)
@@ -49,7 +54,15 @@ def main():
     last = {}
     samples = []  # (sim minutes, rss bytes, map bytes, received, integrated, dropped)
 
+    errors = []  # rospy logs a callback's exception and goes on: counted here, failing the run
+
     def on_status(s):
+        try:
+            sample(s)
+        except Exception as e:  # noqa: BLE001 - any error in a sample fails the soak
+            errors.append(repr(e))
+
+    def sample(s):
         t = s.header.stamp.to_sec() - bag_start
         with lock:
             last["status"] = s
@@ -57,11 +70,7 @@ def main():
             minute = int(t // 60.0)
             if minute >= len(samples):
                 received = sum(i.received for i in s.inputs)
-                dropped = sum(i.dropped_empty + i.dropped_size_mismatch + i.dropped_bad_angles +
-                              i.dropped_bad_frame + i.dropped_tf_unavailable +
-                              i.dropped_tf_too_old + i.dropped_no_valid_beam +
-                              i.dropped_bad_geometry + i.dropped_bad_time + i.dropped_exception
-                              for i in s.inputs)
+                dropped = sum(dropped_of(i) for i in s.inputs)
                 samples.append((t / 60.0, rss_bytes(a.pid), s.bytes, received,
                                 s.scans_integrated, dropped))
 
@@ -137,6 +146,14 @@ def main():
                os.path.join(a.out, "soak.txt")))
     with open(os.path.join(a.out, "soak.txt"), "w") as f:
         f.write(text)
+    if errors:
+        print("soak: %d status samples failed, the first: %s" % (len(errors), errors[0]),
+              file=sys.stderr)
+        return 1
+    if m[-1] >= 2.0 and fit.sum() < 2:
+        print("soak: %d samples over %.1f simulated min: too few for a slope" % (len(samples), m[-1]),
+              file=sys.stderr)
+        return 1
     return 1 if lost != 0 else 0
 
 
