@@ -283,6 +283,7 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   EXPECT_EQ(site_diag.get("layers refused: bad layer"), "0");
   EXPECT_EQ(site_diag.get("layers refused: shards disagree"), "0");
   EXPECT_EQ(site_diag.get("layers refused: over max_cells"), "0");
+  EXPECT_EQ(site_diag.get("topics without a publisher"), "0");
 
   // ---- the shard rule: the saved maps, as floats, every cell at every scale.
   const std::string stem = "/tmp/wavog_fleet_shards_" + std::to_string(getpid());

@@ -110,10 +110,39 @@ int main(int argc, char** argv) {
 
   wavog_fleet::SiteVehicles site;
   std::map<std::string, ros::WallTime> warned;
+  // Topics without a publisher and nothing received kSilentAfter s after start: a shard's
+  // namespace or a scale it does not publish (publish_scales) would otherwise leave the site
+  // layers silently empty. (A shard with nothing observed in its region yet advertises its
+  // layers but sends none: not counted.)
+  constexpr double kSilentAfter = 10.0;
+  const ros::WallTime started = ros::WallTime::now();
+  std::vector<std::string> silent;
+  ros::WallTime silent_warned;
   ros::WallTimer status_timer =
       nh.createWallTimer(ros::WallDuration(1.0), [&](const ros::WallTimerEvent&) {
         site = wavog_fleet::summariseVehicles(statuses, shards);
         const ros::WallTime now = ros::WallTime::now();
+        silent.clear();
+        for (const auto& kv : layers) {
+          for (std::size_t i = 0; i < shards.size(); ++i) {
+            if (kv.second.latest[i] || kv.second.subs[i].getNumPublishers() > 0) continue;
+            silent.push_back(kv.second.subs[i].getTopic());
+          }
+        }
+        for (std::size_t i = 0; i < shards.size(); ++i) {
+          if (statuses[i] || status_subs[i].getNumPublishers() > 0) continue;
+          silent.push_back(status_subs[i].getTopic());
+        }
+        if (!silent.empty() && (now - started).toSec() >= kSilentAfter &&
+            (silent_warned.isZero() || (now - silent_warned).toSec() >= 10.0)) {
+          silent_warned = now;
+          std::string names;
+          for (const auto& t : silent) names += " " + t;
+          ROS_WARN(
+              "wavog_site: no publisher after %.0f s on %zu topics (is each shard's "
+              "namespace in ~shards, and each of ~scales in its publish_scales?):%s",
+              (now - started).toSec(), silent.size(), names.c_str());
+        }
         for (const auto& v : site.outside) {
           auto it = warned.find(v.vehicle);
           if (it != warned.end() && (now - it->second).toSec() < 5.0) continue;
@@ -158,7 +187,10 @@ int main(int argc, char** argv) {
   updater.setHardwareID("wavog_mapping");
   updater.add("site", [&](diagnostic_updater::DiagnosticStatusWrapper& s) {
     const std::uint64_t refused = refusals.bad_layer + refusals.mismatch + refusals.too_large;
-    if (refused > 0) {
+    if (!silent.empty() && (ros::WallTime::now() - started).toSec() >= kSilentAfter) {
+      s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                "no publisher on " + std::to_string(silent.size()) + " topics: " + silent[0]);
+    } else if (refused > 0) {
       s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "layers refused: " + refusals.last);
     } else if (!site.outside.empty()) {
       s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
@@ -173,6 +205,7 @@ int main(int argc, char** argv) {
     s.add("layers refused: shards disagree", refusals.mismatch);
     s.add("layers refused: over max_cells", refusals.too_large);
     s.add("every shard reported", site.complete);
+    s.add("topics without a publisher", silent.size());
     s.add("vehicles outside every region", site.outside.size());
     std::string names;
     for (const auto& v : site.outside) names += (names.empty() ? "" : " ") + v.vehicle;
