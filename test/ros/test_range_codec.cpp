@@ -82,9 +82,12 @@ TEST(RangeCodec, ReturnsRoundTripWithinHalfAStep) {
 TEST(RangeCodec, SpecialValuesKeepTheirClass) {
   // As a LaserScan gives them: float32 limits.
   const double range_min = static_cast<double>(0.06f), range_max = 50.0;
-  const std::vector<float> r = {kNan,  -kInf, -1.0f, 0.0f, -0.0f, 0.05f,  // invalid
-                                kInf,  50.0f, 51.0f, 3e38f,               // no return
-                                0.06f, 49.999f, std::nextafter(50.0f, 0.0f), 0.0604f};
+  const std::vector<float> r = {kNan,   -kInf,   -1.0f,
+                                0.0f,   -0.0f,   0.05f,  // invalid
+                                kInf,   50.0f,   51.0f,
+                                3e38f,  // no return
+                                0.06f,  49.999f, std::nextafter(50.0f, 0.0f),
+                                0.0604f};
   RangeCodec c;
   ASSERT_TRUE(c.encode(viewOf(r, range_min, range_max), params10cm()));
   EXPECT_EQ(c.step(), kRangeStep);
@@ -126,7 +129,8 @@ TEST(RangeCodec, ReachFollowsMaxRangeAndTheHardLimit) {
   ASSERT_TRUE(c.encode(viewOf(far, 0.1, std::numeric_limits<double>::infinity()), params10cm()));
   const double hard = wavog::hardRangeLimit(params10cm().grid, far.size());
   EXPECT_GT(hard, 500.0);
-  EXPECT_DOUBLE_EQ(c.step(), hard / kMaxHitCode);
+  // Readings beyond the hard limit are possible (range_max +inf): one code is left above.
+  EXPECT_DOUBLE_EQ(c.step(), hard / (kMaxHitCode - 1));
   EXPECT_NEAR(c.decoded()[0], 500.0, c.step());
   // A window of returns narrower than a step: nothing fits, the caller sends floats.
   const std::vector<float> narrow = {1.0002f};
@@ -160,6 +164,38 @@ TEST(RangeCodec, TheCoreClassifiesDecodedBeamsAsTheReadings) {
     EXPECT_EQ(sa.beams_no_return, sb.beams_no_return);
     EXPECT_EQ(sa.beams_beyond_limit, sb.beams_beyond_limit);
   }
+}
+
+TEST(RangeCodec, ReadingsBeyondTheHardLimitStayBeyondIt) {
+  // 4,000 beams at 10 cm: the core's hard limit (8,388,608 beam-cells / beams, 209.7 m) lies
+  // below range_max 300 m. Readings between the two are no returns the core counts as beyond its
+  // limit; their codes must decode to such readings (before: +inf, counted as plain no returns).
+  const wavog::MapParams p = params10cm();
+  const double hard = wavog::hardRangeLimit(p.grid, 4000);
+  ASSERT_LT(hard, 300.0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> any(-1.0f, 320.0f);
+  std::vector<float> r(4000);
+  for (float& x : r) x = any(rng);
+  r[0] = static_cast<float>(hard);  // at the limit: beyond it
+  r[1] = std::nextafter(300.0f, 0.0f);
+  r[2] = 300.0f;  // range_max: a plain no return
+  r[3] = kInf;
+  const wavog::ScanView view = viewOf(r, 0.1, 300.0);
+  RangeCodec c;
+  ASSERT_TRUE(c.encode(view, p));
+  EXPECT_NE(c.codes()[0], kNoReturnCode);
+  EXPECT_NE(c.codes()[1], kNoReturnCode);
+  EXPECT_EQ(c.codes()[2], kNoReturnCode);
+  EXPECT_EQ(c.codes()[3], kNoReturnCode);
+  wavog::WaveletMap a(p), b(p);
+  const wavog::IntegrateStats sa = a.integrate(wavog::Pose2{0, 0, 0}, view);
+  const wavog::IntegrateStats sb = b.integrate(wavog::Pose2{0, 0, 0}, c.decodedView(view));
+  EXPECT_GT(sa.beams_beyond_limit, 500u);
+  EXPECT_EQ(sa.beams_beyond_limit, sb.beams_beyond_limit);
+  EXPECT_EQ(sa.beams_no_return, sb.beams_no_return);
+  EXPECT_EQ(sa.beams_hit, sb.beams_hit);
+  EXPECT_EQ(sa.beams_invalid, sb.beams_invalid);
 }
 
 }  // namespace

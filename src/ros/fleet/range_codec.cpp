@@ -8,18 +8,27 @@
 
 namespace wavog_fleet {
 
-double scanReach(const wavog::MapParams& params, double range_max, std::size_t count) {
-  // As the core's beam limits (classify/prepared_scan.cpp): the same expressions, the same value.
-  const double given = params.sensor.max_range > 0 ? std::min(params.sensor.max_range, range_max)
-                                                   : range_max;
-  return std::min(given, wavog::hardRangeLimit(params.grid, count));
+namespace {
+
+// As the core's beam limits (classify/prepared_scan.cpp): the same expressions, the same values.
+double givenReach(const wavog::MapParams& params, double range_max) {
+  return params.sensor.max_range > 0 ? std::min(params.sensor.max_range, range_max) : range_max;
 }
 
-double rangeStep(double reach) { return std::max(kRangeStep, reach / kMaxHitCode); }
+}  // namespace
+
+double scanReach(const wavog::MapParams& params, double range_max, std::size_t count) {
+  return std::min(givenReach(params, range_max), wavog::hardRangeLimit(params.grid, count));
+}
+
+double rangeStep(double reach, bool beyond) {
+  return std::max(kRangeStep, reach / (beyond ? kMaxHitCode - 1 : kMaxHitCode));
+}
 
 bool RangeCodec::encode(const wavog::ScanView& view, const wavog::MapParams& params) {
   const double reach = scanReach(params, view.range_max, view.count);
-  const double step = rangeStep(reach);
+  const double given = givenReach(params, view.range_max);
+  const double step = rangeStep(reach, given > reach);
   const double range_min = view.range_min;
   if (!(reach > 0.0) || !std::isfinite(step) || !(range_min >= 0.0) ||
       !(range_min / step < kMaxHitCode)) {
@@ -35,6 +44,14 @@ bool RangeCodec::encode(const wavog::ScanView& view, const wavog::MapParams& par
   long hi = std::min(static_cast<long>(kMaxHitCode), static_cast<long>(std::floor(reach / step)));
   while (hi >= 1 && !(decoded(hi) < reach)) --hi;
   if (lo > hi) return false;
+  // A reading at or beyond the reach but below range_max (max_range) is a no return the core
+  // counts as beyond its hard limit (beams_beyond_limit). It gets the code above the returns' when
+  // that decodes into [reach, given): the decoded scan counts it the same, and the map is the same
+  // (every no return clears alike). Else, or without a hard limit below range_max, 65535.
+  std::uint16_t beyond = kNoReturnCode;
+  if (hi + 1 <= kMaxHitCode && decoded(hi + 1) >= reach && decoded(hi + 1) < given) {
+    beyond = static_cast<std::uint16_t>(hi + 1);
+  }
   step_ = step;
   codes_.resize(view.count);
   decoded_.resize(view.count);
@@ -46,6 +63,8 @@ bool RangeCodec::encode(const wavog::ScanView& view, const wavog::MapParams& par
       code = kInvalidCode;
     } else if (z < reach) {
       code = static_cast<std::uint16_t>(std::clamp(std::lround(z / step), lo, hi));
+    } else if (z < given) {
+      code = beyond;
     }
     codes_[j] = code;
     decoded_[j] = decodeRange(code, step);

@@ -7,9 +7,11 @@
 // range_min), decoded as NaN; kNoReturnCode (65535) for a reading at or beyond the scan's reach
 // (+inf, range_max, the core's limits), decoded as +inf; k in [1, kMaxHitCode] for a return,
 // decoded as float(k * step). The step is kRangeStep (1 mm), or reach / kMaxHitCode for a scan
-// reaching farther than 65.534 m, so that every return below the reach keeps a code, and a return
-// always decodes to a return: within [range_min, reach). ROS-free; not thread-safe (one per
-// caller).
+// reaching farther than 65.534 m (reach / (kMaxHitCode - 1) when the hard limit binds, below), so that every return below the reach keeps a code, and a return
+// always decodes to a return: within [range_min, reach). A reading beyond the core's hard limit
+// but below range_max takes the code just above the returns' when it decodes into that interval,
+// so that the core counts it as beyond its limit on both sides (beams_beyond_limit); it is a no
+// return like any other. ROS-free; not thread-safe (one per caller).
 #ifndef WAVOG_MAPPING_SRC_ROS_FLEET_RANGE_CODEC_H_
 #define WAVOG_MAPPING_SRC_ROS_FLEET_RANGE_CODEC_H_
 
@@ -36,8 +38,10 @@ constexpr double kMaxRangeStep = 128.0;
 /// The reach (m) of a scan of `count` beams with limit `range_max` on a map of `params`: a reading
 /// at or beyond it is a no return for the core (max_range, range_max, hardRangeLimit()).
 double scanReach(const wavog::MapParams& params, double range_max, std::size_t count);
-/// The step (m) for a scan of that reach: kRangeStep, or reach / kMaxHitCode if coarser.
-double rangeStep(double reach);
+/// The step (m) for a scan of that reach: kRangeStep, or reach / kMaxHitCode if coarser; with
+/// `beyond` (the core's hard limit lies below range_max) reach / (kMaxHitCode - 1), which leaves
+/// kMaxHitCode for the readings beyond the limit.
+double rangeStep(double reach, bool beyond = false);
 /// What a code stands for (m), the same on every side of the stream.
 inline float decodeRange(std::uint16_t code, double step) {
   if (code == kInvalidCode) return std::numeric_limits<float>::quiet_NaN();
