@@ -175,9 +175,12 @@ int main(int argc, char** argv) {
           if (r == wavog_fleet::SiteRefusal::kBadLayer) ++refusals.bad_layer;
           if (r == wavog_fleet::SiteRefusal::kMismatch) ++refusals.mismatch;
           if (r == wavog_fleet::SiteRefusal::kTooLarge) ++refusals.too_large;
-          if (r != wavog_fleet::SiteRefusal::kNothingKnown) {
-            refusals.last = "site_map_scale_" + std::to_string(l.scale) + ": " + why;
+          if (r == wavog_fleet::SiteRefusal::kNothingKnown) {  // no vehicle in any region yet
+            ROS_INFO_THROTTLE(30.0, "wavog_site: site_map_scale_%d not published yet: %s",
+                              l.scale, why.c_str());
+            continue;
           }
+          refusals.last = "site_map_scale_" + std::to_string(l.scale) + ": " + why;
           ROS_WARN_THROTTLE(5.0, "wavog_site: site_map_scale_%d not published: %s", l.scale,
                             why.c_str());
         }
