@@ -50,7 +50,7 @@ if(WAVOG_FUZZ)
        AND EXISTS /usr/share/std_msgs/msg/Header.msg)
       set(_msgs ${CMAKE_BINARY_DIR}/fuzz_msgs)
       set(_headers)
-      foreach(_m PlacedScan VehicleStatus)
+      foreach(_m PlacedScan VehicleStatus FleetStatus)
         list(APPEND _headers ${_msgs}/wavog_mapping/${_m}.h)
         add_custom_command(OUTPUT ${_msgs}/wavog_mapping/${_m}.h
           COMMAND ${WAVOG_FUZZ_PYTHON3} /usr/lib/gencpp/gen_cpp.py
@@ -58,7 +58,7 @@ if(WAVOG_FUZZ)
             -Iwavog_mapping:${CMAKE_CURRENT_SOURCE_DIR}/msg -Istd_msgs:/usr/share/std_msgs/msg
             -p wavog_mapping -o ${_msgs}/wavog_mapping -e /usr/share/gencpp
           DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/msg/${_m}.msg
-          COMMENT "gencpp: ${_m}.h for fuzz_fleet")
+          COMMENT "gencpp: ${_m}.h for fuzz_fleet and fuzz_site")
       endforeach()
       add_custom_target(wavog_fuzz_msgs DEPENDS ${_headers})
       add_library(wavog_fuzz_fleet_glue STATIC src/ros/fleet/placed_scan.cpp
@@ -71,6 +71,14 @@ if(WAVOG_FUZZ)
       target_link_libraries(wavog_fuzz_fleet_glue PUBLIC wavog_fuzz_node_glue)
       wavog_fuzzer(fuzz_fleet)
       target_link_libraries(fuzz_fleet PRIVATE wavog_fuzz_fleet_glue)
+
+      # 6: wavog_site's parts (site_layers, site_vehicles): the shards' layers and statuses.
+      add_library(wavog_fuzz_site_glue STATIC src/ros/fleet/site_layers.cpp
+        src/ros/fleet/site_vehicles.cpp)
+      add_dependencies(wavog_fuzz_site_glue wavog_fuzz_msgs)
+      target_link_libraries(wavog_fuzz_site_glue PUBLIC wavog_fuzz_fleet_glue)
+      wavog_fuzzer(fuzz_site)
+      target_link_libraries(fuzz_site PRIVATE wavog_fuzz_site_glue)
     else()
       message(WARNING "fuzz_fleet not built: /usr/lib/gencpp/gen_cpp.py or std_msgs missing")
     endif()

@@ -17,7 +17,7 @@ FUZZ_LONG_SECONDS ?= 10800
 FUZZ_JOBS ?= $(JOBS)
 
 .PHONY: fuzz fuzz-configure fuzz-build fuzz-long
-## libFuzzer harnesses (map loader, CARMEN reader, scan integration, node and fleet message paths), FUZZ_SECONDS each.
+## libFuzzer harnesses (map loader, CARMEN reader, scan integration, node, fleet and site message paths), FUZZ_SECONDS each.
 fuzz: fuzz-build
 	@FUZZ_JOBS=$(FUZZ_JOBS) bash $(ROOT)/scripts/run_fuzz.sh $(BUILD_FUZZ) $(FUZZ_SECONDS)
 

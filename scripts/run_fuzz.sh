@@ -12,7 +12,7 @@ seconds=${2:?usage: run_fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
 shift 2
 root=$(cd "$(dirname "$0")/.." && pwd)
 harnesses=("$@")
-[ ${#harnesses[@]} -eq 0 ] && harnesses=(fuzz_map_load fuzz_carmen fuzz_integrate fuzz_node fuzz_fleet)
+[ ${#harnesses[@]} -eq 0 ] && harnesses=(fuzz_map_load fuzz_carmen fuzz_integrate fuzz_node fuzz_fleet fuzz_site)
 
 # Leaks count as findings; UBSan already aborts (-fno-sanitize-recover=all).
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:allocator_may_return_null=0}
