@@ -58,8 +58,15 @@ void MappingRos::Impl::startFleet(MapperRole role) {
       },
       updater_.get());
   if (rp.fleet_window > 0.0) {
-    fleet_windows_ =
-        std::make_unique<wavog_fleet::VehicleWindows>(nh_, rp.fleet_vehicles, rp.fleet_window);
+    // A region shard's window holds its region's cells only: published in its private namespace
+    // (~<vehicle>/fleet_map), so that the shards of a site never publish on one topic.
+    ros::NodeHandle where = nh_;
+    std::vector<std::string> names = rp.fleet_vehicles;
+    if (!rp.fleet_region.empty()) {
+      where = pnh_;
+      for (std::string& n : names) n.erase(0, n.find_first_not_of('/'));
+    }
+    fleet_windows_ = std::make_unique<wavog_fleet::VehicleWindows>(where, names, rp.fleet_window);
   }
 }
 

@@ -205,6 +205,11 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   subs.push_back(
       nh.subscribe<nav_msgs::OccupancyGrid>("/site_map_scale_3", 2, boost::ref(site_scale)));
   subs.push_back(nh.subscribe<nav_msgs::OccupancyGrid>("/v1/fleet_map", 2, boost::ref(window)));
+  const std::size_t window_sub = subs.size() - 1;
+  // shard_a's window of v1 (its region only), in its private namespace.
+  Latest<nav_msgs::OccupancyGrid> shard_window;
+  subs.push_back(nh.subscribe<nav_msgs::OccupancyGrid>("/shard_a/wavog_fleet/v1/fleet_map", 2,
+                                                       boost::ref(shard_window)));
   subs.push_back(nh.subscribe<map_msgs::OccupancyGridUpdate>("/v1/fleet_map_updates", 100,
                                                              boost::ref(window_update)));
   SiteDiagnostics site_diag;
@@ -372,6 +377,21 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
       win->info.width, win->info.height, window.count, window.bytes, window_update.count,
       window_update.bytes, scans.size(), kDuration);
   EXPECT_GT(window_update.count, 0u);
+  // A shard's window: its own topic (/v1/fleet_map has the unsharded node alone), its region's
+  // cells only, each the fleet map's.
+  EXPECT_EQ(subs[window_sub].getNumPublishers(), 1u) << "publishers of /v1/fleet_map";
+  const ros::WallTime shard_until = ros::WallTime::now() + ros::WallDuration(10.0);
+  while (ros::WallTime::now() < shard_until && !fresh(shard_window)) {
+    ros::WallDuration(0.1).sleep();
+  }
+  ASSERT_TRUE(fresh(shard_window));
+  const auto sw = shard_window.get();
+  const auto [shard_differ, shard_known] = gridDiff(*sw, *all_map.get());
+  EXPECT_EQ(shard_differ, 0u) << "of " << sw->data.size();
+  const auto [east_differ, east_known_cells] =
+      gridDiff(*sw, *all_map.get(), wavog::CellBox{384, -1000000, 1000000, 1000000});
+  EXPECT_EQ(east_known_cells, 0u) << "shard_a's window holds cells east of its region";
+  std::printf("shard_a's window of v1: %zu known cells\n", shard_known);
 
   // ---- a shard restarts and catches up from its own ~save_map (map_file): its map is that map,
   // cell for cell, before any scan reaches it.
