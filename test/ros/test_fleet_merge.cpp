@@ -17,6 +17,7 @@
 
 #include "fleet/placed_scan.h"
 #include "fleet/reorder_buffer.h"
+#include "map_compare.h"
 #include "placed_scan_fixture.h"
 #include "wavog_mapping/core/scan_period.h"
 #include "wavog_mapping/core/wavelet_map.h"
@@ -268,14 +269,8 @@ void expectSameCells(const wavog::WaveletMap& a, const wavog::WaveletMap& b, con
   const wavog::Raster ra = a.exportScale(0, ba, wavog::Aggregation::kMean);
   const wavog::Raster rb = b.exportScale(0, bb, wavog::Aggregation::kMean);
   ASSERT_EQ(ra.log_odds.size(), rb.log_odds.size());
-  std::size_t differ = 0, known = 0;
-  for (std::size_t i = 0; i < ra.log_odds.size(); ++i) {
-    known += ra.known[i];
-    if (ra.known[i] != rb.known[i] ||
-        std::memcmp(&ra.log_odds[i], &rb.log_odds[i], sizeof(float)) != 0) {
-      ++differ;
-    }
-  }
+  const std::size_t differ = map_compare::differingCells(ra, rb);
+  const std::size_t known = map_compare::knownCells(ra);
   EXPECT_EQ(differ, 0u) << what << ": cells that differ of " << ra.log_odds.size();
   EXPECT_GT(known, 10000u) << what;  // a real map, not two empty ones
 }

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "fleet_test_support.h"
+#include "map_compare.h"
 #include "wavog_mapping/FleetStatus.h"
 #include "wavog_mapping/PlacedScan.h"
 #include "wavog_mapping/SaveMap.h"
@@ -421,11 +422,7 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
                 ba.max_y == bb.max_y);
     const wavog::Raster ra = again.exportScale(0, ba, wavog::Aggregation::kMean);
     const wavog::Raster rb = maps[2].exportScale(0, bb, wavog::Aggregation::kMean);
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < ra.log_odds.size(); ++i) {
-      differ += ra.known[i] != rb.known[i] ||
-                std::memcmp(&ra.log_odds[i], &rb.log_odds[i], sizeof(float)) != 0;
-    }
+    const std::size_t differ = map_compare::differingCells(ra, rb);
     EXPECT_EQ(differ, 0u) << "of " << ra.log_odds.size();
   }
   for (const std::string& name : {"all", "shard_a", "shard_b", "restarted"}) {

@@ -18,7 +18,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -28,6 +27,7 @@
 
 #include "fleet/placed_scan.h"
 #include "fleet_test_support.h"
+#include "map_compare.h"
 #include "wavog_mapping/FleetStatus.h"
 #include "wavog_mapping/PlacedScan.h"
 #include "wavog_mapping/SaveMap.h"
@@ -286,12 +286,8 @@ TEST(Fleet, ThreeVehiclesOneMap) {
               bf.max_y == bs.max_y);
   const wavog::Raster rf = fleet.exportScale(0, bf, wavog::Aggregation::kMean);
   const wavog::Raster rs = single.exportScale(0, bs, wavog::Aggregation::kMean);
-  std::size_t differ = 0, known = 0;
-  for (std::size_t i = 0; i < rf.log_odds.size(); ++i) {
-    known += rf.known[i];
-    differ += rf.known[i] != rs.known[i] ||
-              std::memcmp(&rf.log_odds[i], &rs.log_odds[i], sizeof(float)) != 0;
-  }
+  const std::size_t differ = map_compare::differingCells(rf, rs);
+  const std::size_t known = map_compare::knownCells(rf);
   EXPECT_EQ(differ, 0u) << "of " << rf.log_odds.size() << " cells (" << total << " scans)";
   EXPECT_GT(known, 100000u);
 
@@ -315,11 +311,7 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   ASSERT_TRUE(bl.min_x == bf.min_x && bl.min_y == bf.min_y && bl.max_x == bf.max_x &&
               bl.max_y == bf.max_y);
   const wavog::Raster rl = caught.exportScale(0, bl, wavog::Aggregation::kMean);
-  std::size_t differ_late = 0;
-  for (std::size_t i = 0; i < rf.log_odds.size(); ++i) {
-    differ_late += rf.known[i] != rl.known[i] ||
-                   std::memcmp(&rf.log_odds[i], &rl.log_odds[i], sizeof(float)) != 0;
-  }
+  const std::size_t differ_late = map_compare::differingCells(rf, rl);
   EXPECT_EQ(differ_late, 0u) << "of " << rf.log_odds.size() << " cells";
 
   // ---- each vehicle's own map is its stream replayed alone (v1, v3; v2's map may hold a few
@@ -341,11 +333,7 @@ TEST(Fleet, ThreeVehiclesOneMap) {
                 bo.max_y == br.max_y);
     const wavog::Raster ro = own.exportScale(0, bo, wavog::Aggregation::kMean);
     const wavog::Raster rr = replayed.exportScale(0, br, wavog::Aggregation::kMean);
-    std::size_t differ_own = 0;
-    for (std::size_t i = 0; i < ro.log_odds.size(); ++i) {
-      differ_own += ro.known[i] != rr.known[i] ||
-                    std::memcmp(&ro.log_odds[i], &rr.log_odds[i], sizeof(float)) != 0;
-    }
+    const std::size_t differ_own = map_compare::differingCells(ro, rr);
     EXPECT_EQ(differ_own, 0u) << "of " << ro.log_odds.size() << " cells";
   }
 
