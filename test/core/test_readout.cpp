@@ -50,6 +50,27 @@ TEST(Readout, OccupancyValues) {
   EXPECT_EQ(g[2], 1);
 }
 
+// The trinary values (map_server's rule): above occupied_thresh 100, below free_thresh 0,
+// between and never observed -1; graded values are the same as toOccupancyGrid(raster).
+TEST(Readout, TrinaryValuesFollowTheThresholds) {
+  const auto logit = [](double p) { return static_cast<float>(std::log(p / (1.0 - p))); };
+  wavog::Raster r;
+  r.log_odds = {0.0f, logit(0.66), logit(0.64), logit(0.20), logit(0.19), 20.0f, -20.0f, 5.0f};
+  r.known = {1, 1, 1, 1, 1, 1, 1, 0};
+  const wavog::GridValues trinary;  // 0.65 / 0.196
+  const std::vector<std::int8_t> expect = {-1, 100, -1, -1, 0, 100, 0, -1};
+  EXPECT_EQ(wavog::toOccupancyGrid(r, trinary), expect);
+  wavog::GridValues strict;
+  strict.occupied_thresh = 0.9;
+  strict.free_thresh = 0.1;
+  EXPECT_EQ(wavog::toOccupancyGrid(r, strict),
+            (std::vector<std::int8_t>{-1, -1, -1, -1, -1, 100, 0, -1}));
+  wavog::GridValues graded;
+  graded.trinary = false;
+  EXPECT_EQ(wavog::toOccupancyGrid(r, graded), wavog::toOccupancyGrid(r));
+  EXPECT_EQ(wavog::gridValue(std::numeric_limits<float>::quiet_NaN(), true, trinary), -1);
+}
+
 TEST(Readout, HitBeatsMissInOneScanAndUnknownStaysUnknown) {
   WaveletMap map(params());
   const auto s = wallScan();

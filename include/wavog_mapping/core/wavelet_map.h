@@ -121,6 +121,19 @@ double probabilityFromLogOdds(float log_odds);
 std::int8_t occupancyFromLogOdds(float log_odds);
 /// OccupancyGrid values of a raster, same order: -1 where unknown, else occupancyFromLogOdds.
 std::vector<std::int8_t> toOccupancyGrid(const Raster& raster);
+
+/// How the log-odds of a layer become OccupancyGrid values. Trinary is ROS's map convention, what
+/// map_server, amcl and costmap_2d's static layer read: P(occ) above occupied_thresh is 100, below
+/// free_thresh 0, between (and never observed) -1. Graded: round(100 P(occ)), -1 never observed.
+struct GridValues {
+  bool trinary = true;
+  double occupied_thresh = 0.65;  ///< map_server's default
+  double free_thresh = 0.196;     ///< map_server's default
+};
+/// The OccupancyGrid value of one cell (known: observed at least once).
+std::int8_t gridValue(float log_odds, bool known, const GridValues& values);
+/// OccupancyGrid values of a raster under `values`, same order.
+std::vector<std::int8_t> toOccupancyGrid(const Raster& raster, const GridValues& values);
 /// OccupancyGrid values of reflection probabilities: -1 where NaN, else round(100 p).
 std::vector<std::int8_t> toOccupancyGrid(const ReflectionRaster& raster);
 

@@ -115,6 +115,24 @@ std::vector<std::int8_t> toOccupancyGrid(const Raster& raster) {
   return out;
 }
 
+std::int8_t gridValue(float log_odds, bool known, const GridValues& values) {
+  if (!known) return -1;
+  if (!values.trinary) return occupancyFromLogOdds(log_odds);
+  if (std::isnan(log_odds)) return -1;
+  const double p = probabilityFromLogOdds(log_odds);
+  if (p > values.occupied_thresh) return 100;
+  if (p < values.free_thresh) return 0;
+  return -1;
+}
+
+std::vector<std::int8_t> toOccupancyGrid(const Raster& raster, const GridValues& values) {
+  std::vector<std::int8_t> out(raster.log_odds.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = gridValue(raster.log_odds[i], raster.known[i] != 0, values);
+  }
+  return out;
+}
+
 bool WaveletMap::bounds(int scale, CellBox* box) const {
   const Impl& impl = *impl_;
   if (impl.blocks.empty()) return false;
