@@ -94,6 +94,13 @@ if(CATKIN_ENABLE_TESTING)
     if(TARGET test_node_limits)
       target_link_libraries(test_node_limits wavog_ros ${GTEST_MAIN_LIBRARIES})
     endif()
+    # A layer too large as a whole is the window around the robot (issue 41); on the campus log.
+    add_executable(test_layers test/ros/test_layers.cpp)
+    target_link_libraries(test_layers PRIVATE wavog_ros GTest::GTest GTest::Main)
+    target_compile_options(test_layers PRIVATE ${WAVOG_WARNINGS})
+    set_target_properties(test_layers PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+    wavog_add_gtest(ros_test_layers test_layers ${CMAKE_BINARY_DIR}/test_results/ros ros 600
+                    "fr-campus-corrected.log.gz")
   endif()
   # A rostest with its own gtest binary: the node's message headers, catkin's and gtest's
   # libraries, built after the messages and the node.
@@ -160,11 +167,12 @@ if(CATKIN_ENABLE_TESTING)
         WAVOG_NODELET_BIN="${WAVOG_NODELET_BIN}")
     endif()
 
-    # The test room as a standalone publisher (make rviz-check).
+    # The test room as a standalone publisher (make rviz-check, publish_rate.test).
     add_executable(room_scene test/ros/room_scene.cpp)
     target_link_libraries(room_scene wavog_ros_includes ${catkin_LIBRARIES})
     set_target_properties(room_scene PROPERTIES
       RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+    add_rostest(test/publish_rate.test DEPENDENCIES room_scene)
 
     # Every launch file parses and names existing nodes.
     roslaunch_add_file_check(launch IGNORE_UNSET_ARGS DEPENDENCIES ${WAVOG_ROS_RUNTIME})

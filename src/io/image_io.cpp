@@ -4,8 +4,6 @@
 // never half-written.
 #include "wavog_mapping/io/image_io.h"
 
-#include "wavog_mapping/core/atomic_file.h"
-
 #include <png.h>
 
 #include <algorithm>
@@ -22,6 +20,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <vector>
+
+#include "wavog_mapping/core/atomic_file.h"
 
 namespace wavog {
 namespace {
@@ -108,7 +108,11 @@ Image renderGrey(const Raster& raster, const RenderOptions& options) {
     for (std::int64_t rx = 0; rx < w; ++rx) {
       const std::size_t i = static_cast<std::size_t>(ry * w + rx);
       std::uint8_t v = options.unknown_grey;
-      if (raster.known[i]) {
+      if (options.values.trinary) {
+        const std::int8_t g = gridValue(raster.log_odds[i], raster.known[i] != 0, options.values);
+        if (g == 100) v = 0;
+        if (g == 0) v = 254;
+      } else if (raster.known[i]) {
         v = greyFromLogOdds(raster.log_odds[i]);
         if (v == options.unknown_grey) v = static_cast<std::uint8_t>(v > 0 ? v - 1 : 1);
       }
@@ -235,6 +239,8 @@ std::string writeMapServerMap(const std::string& base, const Raster& raster,
   yaml.resolution = raster.cell_size;
   yaml.origin_x = raster.originX();
   yaml.origin_y = raster.originY();
+  yaml.occupied_thresh = options.values.occupied_thresh;
+  yaml.free_thresh = options.values.free_thresh;
   const std::string yaml_path = base + ".yaml";
   writeMapServerYaml(yaml_path, yaml);
   return yaml_path;

@@ -175,6 +175,19 @@ const std::vector<KeyReader>& readers() {
                                        ") must be one of: mean, max");
          }
        }},
+      {"map_values",
+       [](auto& k, auto& v, Config* c) {
+         const std::string name = asString(k, v);
+         if (name != "trinary" && name != "graded") {
+           throw std::invalid_argument("parameter 'map_values' (" + name +
+                                       ") must be one of: trinary, graded");
+         }
+         c->ros.grid_values.trinary = name == "trinary";
+       }},
+      {"occupied_thresh",
+       [](auto& k, auto& v, Config* c) { c->ros.grid_values.occupied_thresh = asDouble(k, v); }},
+      {"free_thresh",
+       [](auto& k, auto& v, Config* c) { c->ros.grid_values.free_thresh = asDouble(k, v); }},
       {"publish_window",
        [](auto& k, auto& v, Config* c) { c->ros.publish_window = asDouble(k, v); }},
       {"update_rate", [](auto& k, auto& v, Config* c) { c->ros.update_rate = asDouble(k, v); }},

@@ -53,6 +53,12 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
     check(scales.insert(s).second, &e,
           "publish_scales entry (" + std::to_string(s) + ") is listed twice");
   }
+  // Each threshold on its side of P = 0.5 (the prior): the two never cross.
+  const wavog::GridValues& gv = ros.grid_values;
+  check(std::isfinite(gv.occupied_thresh) && gv.occupied_thresh >= 0.5 && gv.occupied_thresh <= 1.0,
+        &e, "occupied_thresh (" + fmt(gv.occupied_thresh) + ") must be in [0.5, 1] (P(occ))");
+  check(std::isfinite(gv.free_thresh) && gv.free_thresh >= 0.0 && gv.free_thresh <= 0.5, &e,
+        "free_thresh (" + fmt(gv.free_thresh) + ") must be in [0, 0.5] (P(occ))");
   check(std::isfinite(ros.publish_window) && ros.publish_window >= 0.0, &e,
         "publish_window (" + fmt(ros.publish_window) + ") must be >= 0 m (0: whole map)");
   check(std::isfinite(ros.update_rate) && ros.update_rate >= 0.0 && ros.update_rate <= 100.0, &e,

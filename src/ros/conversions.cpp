@@ -33,9 +33,9 @@ bool clip(double clip_lo, double clip_hi, double* lo, double* hi) {
 const char* toString(DropReason reason) {
   // In DropReason order.
   static constexpr const char* kNames[kNumDropReasons] = {
-      "empty",         "bad_angles",   "bad_frame",     "tf_unavailable",
-      "tf_too_old",    "no_valid_beam", "bad_geometry", "out_of_extent",
-      "absurd_pose",   "bad_time",      "exception"};
+      "empty",       "bad_angles",    "bad_frame",    "tf_unavailable",
+      "tf_too_old",  "no_valid_beam", "bad_geometry", "out_of_extent",
+      "absurd_pose", "bad_time",      "exception"};
   const auto i = static_cast<std::size_t>(reason);
   return i < kNumDropReasons ? kNames[i] : "unknown";
 }
@@ -149,8 +149,8 @@ std::string geometryRefusal(const wavog::ScanView& v) {
     s << "|angle_min| " << v.angle_min << " rad beyond " << wavog::kMaxAbsAngleMin << " rad";
   } else if (!std::isfinite(v.angle_increment) ||
              !(std::abs(v.angle_increment) >= wavog::kMinAbsAngleIncrement)) {
-    s << "|angle_increment| " << v.angle_increment << " rad below "
-      << wavog::kMinAbsAngleIncrement << " rad";
+    s << "|angle_increment| " << v.angle_increment << " rad below " << wavog::kMinAbsAngleIncrement
+      << " rad";
   } else if (!std::isfinite(v.range_min) || v.range_min < 0.0) {
     s << "range_min " << v.range_min << " m is negative or not finite";
   } else if (!(v.range_max > v.range_min)) {
@@ -185,7 +185,7 @@ void mirrorView(wavog::ScanView* view) {
 }
 
 std::string coreRefusal(const wavog::IntegrateStats& st, const wavog::ScanView& view,
-                          const wavog::Pose2& pose, const wavog::MapParams& params) {
+                        const wavog::Pose2& pose, const wavog::MapParams& params) {
   std::ostringstream s;
   s << "refused by the core (" << wavog::toString(st.status) << "): ";
   switch (st.status) {
@@ -197,13 +197,13 @@ std::string coreRefusal(const wavog::IntegrateStats& st, const wavog::ScanView& 
         << " invalid (NaN, -inf, <= 0 or below range_min " << view.range_min << " m), "
         << st.beams_no_return << " no return (+inf or >= range_max " << view.range_max
         << " m), of which " << st.beams_beyond_limit << " beyond the hard range limit of "
-        << wavog::hardRangeLimit(params.grid, view.count) << " m (limits.h, for "
-        << view.count << " beams at resolution " << params.grid.resolution << " m)";
+        << wavog::hardRangeLimit(params.grid, view.count) << " m (limits.h, for " << view.count
+        << " beams at resolution " << params.grid.resolution << " m)";
       break;
     case wavog::ScanStatus::kOutOfExtent:
       s << "the laser at (" << pose.x << ", " << pose.y << ") m plus its reach leaves the "
-        << "representable extent of +-" << static_cast<double>(wavog::kCellIndexLimit) *
-                                                   params.grid.resolution
+        << "representable extent of +-"
+        << static_cast<double>(wavog::kCellIndexLimit) * params.grid.resolution
         << " m (2^30 cells)";
       break;
     case wavog::ScanStatus::kBadPose:
@@ -243,10 +243,10 @@ LayerSize layerBox(const wavog::WaveletMap& map, int scale, double window, doubl
 }
 
 namespace {
-// The grid message of a raster of either kind (the cells filled by the caller).
+// The grid message of a raster of either kind, its cells `data`.
 template <typename R>
-nav_msgs::OccupancyGrid::Ptr gridMsg(const R& raster, const std::string& frame,
-                                     const ros::Time& stamp) {
+nav_msgs::OccupancyGrid::Ptr gridMsg(const R& raster, std::vector<std::int8_t> data,
+                                     const std::string& frame, const ros::Time& stamp) {
   auto msg = boost::make_shared<nav_msgs::OccupancyGrid>();
   msg->header.frame_id = frame;
   msg->header.stamp = stamp;
@@ -257,19 +257,20 @@ nav_msgs::OccupancyGrid::Ptr gridMsg(const R& raster, const std::string& frame,
   msg->info.origin.position.x = raster.originX();
   msg->info.origin.position.y = raster.originY();
   msg->info.origin.orientation.w = 1.0;
-  msg->data = wavog::toOccupancyGrid(raster);
+  msg->data = std::move(data);
   return msg;
 }
 }  // namespace
 
 nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
+                                                const wavog::GridValues& values,
                                                 const std::string& frame, const ros::Time& stamp) {
-  return gridMsg(raster, frame, stamp);
+  return gridMsg(raster, wavog::toOccupancyGrid(raster, values), frame, stamp);
 }
 
 nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::ReflectionRaster& raster,
                                                 const std::string& frame, const ros::Time& stamp) {
-  return gridMsg(raster, frame, stamp);
+  return gridMsg(raster, wavog::toOccupancyGrid(raster), frame, stamp);
 }
 
 void ndtEllipse(double cov_xx, double cov_xy, double cov_yy, double* major, double* minor,
@@ -352,11 +353,9 @@ sensor_msgs::PointCloud2::Ptr toNdtCloud(const wavog::NdtLayer& layer, const std
   return msg;
 }
 
-map_msgs::OccupancyGridUpdate::Ptr toOccupancyGridUpdateMsg(const wavog::Raster& raster,
-                                                            std::int64_t grid_min_x,
-                                                            std::int64_t grid_min_y,
-                                                            const std::string& frame,
-                                                            const ros::Time& stamp) {
+map_msgs::OccupancyGridUpdate::Ptr toOccupancyGridUpdateMsg(
+    const wavog::Raster& raster, std::int64_t grid_min_x, std::int64_t grid_min_y,
+    const wavog::GridValues& values, const std::string& frame, const ros::Time& stamp) {
   auto msg = boost::make_shared<map_msgs::OccupancyGridUpdate>();
   msg->header.frame_id = frame;
   msg->header.stamp = stamp;
@@ -364,7 +363,7 @@ map_msgs::OccupancyGridUpdate::Ptr toOccupancyGridUpdateMsg(const wavog::Raster&
   msg->y = static_cast<std::int32_t>(raster.box.min_y - grid_min_y);
   msg->width = static_cast<std::uint32_t>(raster.box.width());
   msg->height = static_cast<std::uint32_t>(raster.box.height());
-  msg->data = wavog::toOccupancyGrid(raster);
+  msg->data = wavog::toOccupancyGrid(raster, values);
   return msg;
 }
 

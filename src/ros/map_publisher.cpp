@@ -23,6 +23,20 @@ wavog::Raster emptyRaster(int scale, double resolution) {
   return r;
 }
 
+// A raster over `box` with every cell unknown.
+wavog::Raster unknownRaster(int scale, double resolution, const wavog::CellBox& box) {
+  wavog::Raster r = emptyRaster(scale, resolution);
+  r.box = box;
+  const auto n = static_cast<std::size_t>(box.width()) * static_cast<std::size_t>(box.height());
+  r.log_odds.assign(n, 0.0f);
+  r.known.assign(n, 0);
+  return r;
+}
+
+std::string cellsText(const wavog::CellBox& box) {
+  return std::to_string(box.width()) + " x " + std::to_string(box.height()) + " cells";
+}
+
 /// [lo, hi] clipped to [clip_lo, clip_hi]; false when empty or not finite.
 bool clip(double clip_lo, double clip_hi, double* lo, double* hi) {
   *lo = std::max(*lo, clip_lo);
@@ -106,16 +120,38 @@ void MapPublisher::markAllDirty(double resolution) {
               m(last_full_box_.max_y)});
 }
 
+void MapPublisher::sensorAt(double x, double y) {
+  if (!std::isfinite(x) || !std::isfinite(y)) return;
+  have_sensor_ = true;
+  sensor_x_ = x;
+  sensor_y_ = y;
+}
+
+bool MapPublisher::lastSensor(double* x, double* y) const {
+  *x = sensor_x_;
+  *y = sensor_y_;
+  return have_sensor_;
+}
+
 LayerSize readOccupancy(const wavog::WaveletMap& map, int scale, const RosParams& params, double cx,
-                        double cy, wavog::Raster* raster, std::string* refused) {
+                        double cy, wavog::Raster* raster, std::string* refused,
+                        std::string* windowed) {
   // With a window, the read-out costs what the window holds, never the whole map.
   wavog::CellBox box;
-  const LayerSize size = layerBox(map, scale, params.publish_window, cx, cy, &box);
+  LayerSize size = layerBox(map, scale, params.publish_window, cx, cy, &box);
   *raster = emptyRaster(scale, map.resolution());
-  if (size == LayerSize::kTooLarge) {
-    *refused = "scale " + std::to_string(scale) + ": " + std::to_string(box.width()) + " x " +
-               std::to_string(box.height()) + " cells";
+  if (size == LayerSize::kTooLarge && params.publish_window <= 0.0) {
+    // The whole layer is too large for one message: the square around the robot instead.
+    const wavog::CellBox whole = box;
+    size = layerBox(map, scale, kFallbackWindowCells * std::ldexp(map.resolution(), scale), cx, cy,
+                    &box);
+    if (size == LayerSize::kOk) {
+      *windowed = "scale " + std::to_string(scale) + ": " + cellsText(whole) + ", published as " +
+                  cellsText(box);
+    }
   }
+  if (size == LayerSize::kTooLarge)
+    *refused = "scale " + std::to_string(scale) + ": " + cellsText(box);
   if (size != LayerSize::kOk) return size;
   const wavog::Aggregation aggregation =
       scale == 0 ? wavog::Aggregation::kMean : params.scale_aggregation;
@@ -130,6 +166,7 @@ LayerSize readOccupancy(const wavog::WaveletMap& map, int scale, const RosParams
 Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params, double cx,
                           double cy) {
   Layers out;
+  out.values = params.grid_values;
   // `map`, `reflection`, `ndt_markers` and `ndt_cells` are latched: always published. A scale
   // layer nobody listens to costs nothing; a payload's scale layer reads its occupancy layer for
   // the box, publishing that only when it has listeners too.
@@ -152,11 +189,25 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
     }
   }
   for (Layers::Layer& layer : out.layers) {
-    std::string refused;
-    if (readOccupancy(map, layer.scale, params, cx, cy, &layer.raster, &refused) ==
+    std::string refused, windowed;
+    if (readOccupancy(map, layer.scale, params, cx, cy, &layer.raster, &refused, &windowed) ==
         LayerSize::kTooLarge) {
       out.refused.push_back(refused);
     }
+    if (!windowed.empty()) out.windowed.push_back(windowed);
+    if (layer.raster.box.empty()) {
+      // Nothing observed (yet, or since ~reset): a layer sent before is sent again over its last
+      // box, every cell unknown, so that latched and late subscribers see the reset; before its
+      // first publication it is not sent at all (as gmapping before its first map).
+      const auto last = last_box_.find(layer.scale);
+      if (last != last_box_.end() && refused.empty()) {
+        layer.raster = unknownRaster(layer.scale, map.resolution(), last->second);
+      } else {
+        layer.pub = ros::Publisher();
+        layer.metadata_pub = ros::Publisher();
+      }
+    }
+    if (layer.pub) last_box_[layer.scale] = layer.raster.box;
     if (layer.reflection_pub) {
       layer.reflection = map.exportReflection(layer.scale, layer.raster.box);
       layer.reflection.cell_size = layer.raster.cell_size;  // also for an empty box
@@ -166,11 +217,17 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
       layer.ndt.scale = layer.scale;
       layer.ndt.cell_size = layer.raster.cell_size;  // also for an empty box
     }
-    if (layer.scale == 0) {
+    if (layer.scale == 0 && layer.pub) {
       // The dirty region is reset by map_updates only: re-sending an area the full map already
       // carries is harmless, while two timers of the same period would otherwise starve updates.
+      // Updates wait until a box has gone out twice: topics are separate connections, and an
+      // update must not overtake the first `map` of a new box on its way to a subscriber.
+      const wavog::CellBox& b = layer.raster.box;
+      full_box_stable_ = have_full_ && b.min_x == last_full_box_.min_x &&
+                         b.min_y == last_full_box_.min_y && b.max_x == last_full_box_.max_x &&
+                         b.max_y == last_full_box_.max_y;
       have_full_ = true;
-      last_full_box_ = layer.raster.box;
+      last_full_box_ = b;
     }
   }
   return out;
@@ -179,7 +236,8 @@ Layers MapPublisher::read(const wavog::WaveletMap& map, const RosParams& params,
 void MapPublisher::publish(const Layers& layers, const std::string& frame, const ros::Time& stamp) {
   for (const Layers::Layer& layer : layers.layers) {
     if (layer.pub) {
-      const nav_msgs::OccupancyGrid::Ptr grid = toOccupancyGridMsg(layer.raster, frame, stamp);
+      const nav_msgs::OccupancyGrid::Ptr grid =
+          toOccupancyGridMsg(layer.raster, layers.values, frame, stamp);
       layer.pub.publish(grid);
       if (layer.metadata_pub) layer.metadata_pub.publish(grid->info);
     }
@@ -193,7 +251,7 @@ void MapPublisher::publish(const Layers& layers, const std::string& frame, const
 
 bool MapPublisher::readUpdate(const wavog::WaveletMap& map, wavog::Raster* raster,
                               wavog::CellBox* full) {
-  if (!dirty_.any || !have_full_) return false;
+  if (!dirty_.any || !have_full_ || !full_box_stable_) return false;
   *full = last_full_box_;
   // The dirty region clipped to the last full map in metres first: a scan's reach may be huge.
   MapBox d = dirty_.box;
@@ -216,8 +274,10 @@ bool MapPublisher::readUpdate(const wavog::WaveletMap& map, wavog::Raster* raste
 }
 
 void MapPublisher::publishUpdate(const wavog::Raster& raster, const wavog::CellBox& full,
-                                 const std::string& frame, const ros::Time& stamp) const {
-  update_pub_.publish(toOccupancyGridUpdateMsg(raster, full.min_x, full.min_y, frame, stamp));
+                                 const wavog::GridValues& values, const std::string& frame,
+                                 const ros::Time& stamp) const {
+  update_pub_.publish(
+      toOccupancyGridUpdateMsg(raster, full.min_x, full.min_y, values, frame, stamp));
 }
 
 }  // namespace wavog_ros

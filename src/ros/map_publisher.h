@@ -49,16 +49,25 @@ struct Layers {
     wavog::NdtLayer ndt;                 ///< over raster's box, when an NDT publisher is set
   };
   std::vector<Layer> layers;
-  std::vector<std::string> refused;  ///< one line per layer larger than kMaxLayerCells
+  std::vector<std::string> refused;   ///< one line per layer larger than kMaxLayerCells
+  std::vector<std::string> windowed;  ///< one line per whole layer published as a window instead
+  wavog::GridValues values;           ///< of the occupancy grids (RosParams::grid_values)
 };
+
+/// Half-width, in cells of its scale, of the square a layer falls back to when the whole layer
+/// would hold more than kMaxLayerCells: (2 x 2046 + 2)^2 cells, within 4096^2 = kMaxLayerCells.
+constexpr double kFallbackWindowCells = 2046.0;
 
 /// The occupancy raster of one layer as it is published: the cells of layerBox() (the window
 /// around (cx, cy) when params.publish_window > 0, else the map's bounds) at `scale`, Haar mean at
 /// scale 0 and params.scale_aggregation above, cut to the observed cells (an empty raster when
-/// none is). kTooLarge: *raster is empty and *refused says the layer's size. Allocates no more
-/// than kMaxLayerCells cells. The map's lock is the caller's.
+/// none is). A whole layer (publish_window 0) larger than kMaxLayerCells falls back to the square
+/// of kFallbackWindowCells around (cx, cy): *windowed then says so ("scale s: W x H cells").
+/// kTooLarge (a publish_window too large): *raster is empty and *refused says the layer's size.
+/// Allocates no more than kMaxLayerCells cells. The map's lock is the caller's.
 LayerSize readOccupancy(const wavog::WaveletMap& map, int scale, const RosParams& params, double cx,
-                        double cy, wavog::Raster* raster, std::string* refused);
+                        double cy, wavog::Raster* raster, std::string* refused,
+                        std::string* windowed);
 
 class MapPublisher {
  public:
@@ -77,21 +86,32 @@ class MapPublisher {
   void touched(const MapBox& box) { dirty_.add(box); }
   /// The next map_updates carries the whole last full grid (after a reset).
   void markAllDirty(double resolution);
+  /// The sensor of the last integrated scan was at (x, y) (map frame, m): the centre of a layer's
+  /// fallback window when base_frame has no pose.
+  void sensorAt(double x, double y);
+  /// Where sensorAt() last put the sensor; false before the first scan.
+  bool lastSensor(double* x, double* y) const;
 
   /// Reads `map` and every layer with subscribers, within `window` (half-width w around cx, cy)
-  /// when w > 0, else the whole map, cut to the box of the observed cells (an empty layer when
-  /// none is). Caller's lock.
+  /// when w > 0, else the whole map, cut to the box of the observed cells. A layer with no
+  /// observed cell is left out before its first publication, and afterwards published over its
+  /// last box with every cell unknown (after ~reset or ~clear_region). Caller's lock.
   Layers read(const wavog::WaveletMap& map, const RosParams& params, double cx, double cy);
-  /// Publishes what read() returned; with `map`, its info on map_metadata. No lock needed.
+  /// Publishes what read() returned; with `map`, its info on map_metadata. No lock needed, but
+  /// read() and publish(), and readUpdate() and publishUpdate(), must not interleave: the caller
+  /// serialises them (MappingRos::Impl::publish_mutex_), so that a map_updates message never
+  /// refers to a `map` that has not been sent.
   static void publish(const Layers& layers, const std::string& frame, const ros::Time& stamp);
 
   bool updateWanted() const { return update_pub_.getNumSubscribers() > 0; }
   /// Reads the dirty region, clipped to the last full `map`, and clears it; false if there is
-  /// nothing to send. Caller's lock.
+  /// nothing to send, or while the box of `map` has just changed (a new box goes out as a full
+  /// `map` twice before updates of it do). Caller's lock.
   bool readUpdate(const wavog::WaveletMap& map, wavog::Raster* raster, wavog::CellBox* full);
-  /// Publishes what readUpdate() returned. No lock needed.
+  /// Publishes what readUpdate() returned with `values`. No lock needed (see publish()).
   void publishUpdate(const wavog::Raster& raster, const wavog::CellBox& full,
-                     const std::string& frame, const ros::Time& stamp) const;
+                     const wavog::GridValues& values, const std::string& frame,
+                     const ros::Time& stamp) const;
 
  private:
   ros::NodeHandle nh_;
@@ -106,6 +126,11 @@ class MapPublisher {
   DirtyRegion dirty_;
   bool have_full_ = false;
   wavog::CellBox last_full_box_;  ///< scale-0 box of the last full `map`
+  bool full_box_stable_ = false;  ///< the last two full `map`s had the same box
+  /// Per scale, the box of the last occupancy grid sent (an emptied layer keeps it).
+  std::map<int, wavog::CellBox> last_box_;
+  bool have_sensor_ = false;
+  double sensor_x_ = 0.0, sensor_y_ = 0.0;
 };
 
 }  // namespace wavog_ros

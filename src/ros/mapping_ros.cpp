@@ -7,8 +7,8 @@
 #include <stdexcept>
 
 #include "fleet/fleet_receiver.h"
-#include "fleet/vehicle_windows.h"
 #include "fleet/fleet_stream.h"
+#include "fleet/vehicle_windows.h"
 #include "mapping_ros_impl.h"
 #include "reconfigure.h"
 
@@ -18,7 +18,7 @@ namespace {
 /// Smallest /tf and /tf_static subscriber queue (the size roscpp's TransformListener uses).
 constexpr int kMinTfQueue = 100;
 /// Period (s) of the /diagnostics updater.
-constexpr double kDiagnosticsPeriod = 0.5;
+constexpr double kDiagnosticsPeriod = 1.0;
 
 Config loadReportingUnknown(const ros::NodeHandle& pnh) {
   std::vector<std::string> unknown;
@@ -36,9 +36,10 @@ Config loadReportingUnknown(const ros::NodeHandle& pnh) {
 void MappingRos::Impl::warnDroppedPayloads(const std::string& path) const {
   const wavog::MapFileContents held = wavog::WaveletMap::inspectFile(path);
   const auto warn = [&](const char* what, const char* key) {
-    ROS_WARN("%s: map_file '%s' holds %s, which this mapper drops (%s: false): a later save_map "
-             "writes the map without it; set %s: true to keep it",
-             pnh_.getNamespace().c_str(), path.c_str(), what, key, key);
+    ROS_WARN(
+        "%s: map_file '%s' holds %s, which this mapper drops (%s: false): a later save_map "
+        "writes the map without it; set %s: true to keep it",
+        pnh_.getNamespace().c_str(), path.c_str(), what, key, key);
   };
   if (held.reflection && !config_.map.reflection) warn("a reflection map", "reflection");
   if (held.ndt && !config_.map.ndt) warn("normal-distribution (NDT) cells", "ndt");
@@ -154,11 +155,10 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
       ic.topic, static_cast<std::uint32_t>(rp.subscriber_queue_size),
       boost::function<void(const ros::MessageEvent<const LaserScan>&)>(
           [this, raw](const ros::MessageEvent<const LaserScan>& event) {
-            guarded("scan callback", raw,
-                    [&] {
-                      onScan(raw, event.getConstMessage(),
-                             reinterpret_cast<std::uintptr_t>(event.getConnectionHeaderPtr().get()));
-                    });
+            guarded("scan callback", raw, [&] {
+              onScan(raw, event.getConstMessage(),
+                     reinterpret_cast<std::uintptr_t>(event.getConnectionHeaderPtr().get()));
+            });
           }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   updater_->add(in->topic + " input", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {
@@ -189,19 +189,23 @@ void MappingRos::Impl::startReconfigure() {
 void MappingRos::Impl::startTimers() {
   const RosParams& rp = config_.ros;
   last_status_time_ = ros::Time::now();
-  publish_timer_ = nh_.createTimer(ros::Duration(1.0 / rp.publish_rate),
-                                   [this](const ros::TimerEvent& e) {
-                                     guarded("publish timer", nullptr, [&] { onPublishTimer(e); });
-                                   });
+  // Outputs run on wall time: with use_sim_time the clock stops with the bag, and ROS timers
+  // with it, while users still echo the layers, the status and /diagnostics.
+  publish_timer_ = nh_.createWallTimer(
+      ros::WallDuration(1.0 / rp.publish_rate), [this](const ros::WallTimerEvent& e) {
+        guarded("publish timer", nullptr, [&] { onPublishTimer(e); });
+      });
   if (rp.update_rate > 0.0) {
-    update_timer_ = nh_.createTimer(ros::Duration(1.0 / rp.update_rate),
-                                    [this](const ros::TimerEvent& e) {
-                                      guarded("update timer", nullptr, [&] { onUpdateTimer(e); });
-                                    });
+    update_timer_ = nh_.createWallTimer(
+        ros::WallDuration(1.0 / rp.update_rate), [this](const ros::WallTimerEvent& e) {
+          guarded("update timer", nullptr, [&] { onUpdateTimer(e); });
+        });
   }
-  diag_timer_ = nh_.createTimer(ros::Duration(kDiagnosticsPeriod), [this](const ros::TimerEvent&) {
-    guarded("diagnostics timer", nullptr, [&] { updater_->update(); });
-  });
+  // force_update(): update() waits for the (stopped) ROS clock to pass its period.
+  diag_timer_ = nh_.createWallTimer(
+      ros::WallDuration(kDiagnosticsPeriod), [this](const ros::WallTimerEvent&) {
+        guarded("diagnostics timer", nullptr, [&] { updater_->force_update(); });
+      });
   if (rp.idle_timeout > 0.0) {
     // Wall time: with use_sim_time the clock stops with the bag, and ROS timers with it.
     noteActivity();
@@ -232,14 +236,14 @@ std::vector<std::string> MappingRos::Impl::onReconfigure(const wavog_mapping::Ma
       ROS_INFO("%s: policy %s, init %s from now on", pnh_.getNamespace().c_str(),
                wavog::toString(next.map.policy.type), wavog::toString(next.map.policy.init));
     }
-    if (config_.map.reflection &&
-        (next.map.policy.type != config_.map.policy.type ||
-         next.map.initValue() != config_.map.initValue() ||
-         next.map.sensor.odd_occ != config_.map.sensor.odd_occ ||
-         next.map.sensor.odd_emp != config_.map.sensor.odd_emp)) {
-      ROS_INFO("%s: the reflection map restarts from no hits and misses (policy, prior or odd "
-               "values changed)",
-               pnh_.getNamespace().c_str());
+    if (config_.map.reflection && (next.map.policy.type != config_.map.policy.type ||
+                                   next.map.initValue() != config_.map.initValue() ||
+                                   next.map.sensor.odd_occ != config_.map.sensor.odd_occ ||
+                                   next.map.sensor.odd_emp != config_.map.sensor.odd_emp)) {
+      ROS_INFO(
+          "%s: the reflection map restarts from no hits and misses (policy, prior or odd "
+          "values changed)",
+          pnh_.getNamespace().c_str());
     }
     // A policy change can make a silent combination (MapParams::warnings) or end one.
     const std::vector<std::string> before = config_.map.warnings();
@@ -253,9 +257,11 @@ std::vector<std::string> MappingRos::Impl::onReconfigure(const wavog_mapping::Ma
     config_.map = next.map;
     config_.ros.publish_rate = next.ros.publish_rate;
     config_.ros.publish_scales = next.ros.publish_scales;
+    config_.ros.grid_values = next.ros.grid_values;
+    config_.ros.scale_aggregation = next.ros.scale_aggregation;
     publisher_->advertiseScales(next.ros.publish_scales);
   }
-  if (new_period > 0.0) publish_timer_.setPeriod(ros::Duration(new_period));
+  if (new_period > 0.0) publish_timer_.setPeriod(ros::WallDuration(new_period));
   return errors;
 }
 

@@ -88,6 +88,7 @@ wavog::IntegrateStats MappingRos::Impl::integratePlacedLocked(const wavog::Pose2
                    static_cast<double>(st.touched.max_x) * res,
                    static_cast<double>(st.touched.max_y) * res};
   publisher_->touched(box);
+  publisher_->sensorAt(pose.x, pose.y);
   if (fleet_windows_) fleet_windows_->touched(box);
   return st;
 }

@@ -27,7 +27,6 @@
 
 #include "input_status.h"
 #include "map_publisher.h"
-#include "wavog_mapping/ros/pose_check.h"
 #include "reconfigure.h"
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"
@@ -38,6 +37,7 @@
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/ros/config.h"
 #include "wavog_mapping/ros/mapping_ros.h"
+#include "wavog_mapping/ros/pose_check.h"
 #include "wavog_mapping/ros/scan_placement.h"
 
 namespace wavog_fleet {
@@ -122,7 +122,8 @@ struct MappingRos::Impl {
   /// buffer without subscriptions. Throws std::invalid_argument on a parameter the role refuses.
   void startFleet(MapperRole role);
   /// The fleet node's core call (the counters and the dirty region, as integrateLocked).
-  wavog::IntegrateStats integratePlacedLocked(const wavog::Pose2& pose, const wavog::ScanView& view);
+  wavog::IntegrateStats integratePlacedLocked(const wavog::Pose2& pose,
+                                              const wavog::ScanView& view);
 
   // ---- what no callback, timer or service lets escape (mapping_ros_scans.cpp)
   /// Counts an exception caught in `where` (and, with an input, the scan as dropped), throttled
@@ -150,16 +151,17 @@ struct MappingRos::Impl {
   void noteActivity();
 
   // ---- publication and status (mapping_ros_publish.cpp)
-  void onPublishTimer(const ros::TimerEvent&);
-  /// The centre of publish_window: base_frame in map_frame from tf (latest); (0, 0) without a
-  /// window. False, with a throttled warning ending in `consequence`, when tf has no such pose.
-  /// Without the lock (tf2's buffer locks itself).
+  void onPublishTimer(const ros::WallTimerEvent&);
+  /// The centre of publish_window and of the fallback window of a layer too large as a whole:
+  /// base_frame in map_frame from tf (latest), else the sensor of the last scan, else (0, 0).
+  /// False, with a throttled warning ending in `consequence`, only with publish_window and neither
+  /// pose. Takes mutex_ itself: call it without.
   bool windowCentre(const char* consequence, double* cx, double* cy);
   /// Reads and publishes every layer and ~status now (timer, end of input, services).
   void publishAll();
   /// Publishes ~status alone (the end of the input when the map has not changed since).
   void publishStatus();
-  void onUpdateTimer(const ros::TimerEvent&);
+  void onUpdateTimer(const ros::WallTimerEvent&);
   wavog_mapping::MapperStatus::Ptr statusLocked(const ros::Time& now);
 
   // ---- /diagnostics (mapping_ros_diagnostics.cpp)
@@ -220,16 +222,18 @@ struct MappingRos::Impl {
 
   ros::Publisher status_pub_;
   ros::ServiceServer reset_srv_, clear_srv_, save_srv_, flush_srv_, dynamic_map_srv_;
-  ros::Timer publish_timer_, update_timer_, diag_timer_;
-  ros::WallTimer idle_timer_;
+  ros::WallTimer publish_timer_, update_timer_, diag_timer_, idle_timer_;
+  /// Serialises publications (publishAll, onUpdateTimer): taken before mutex_, never inside it.
+  std::mutex publish_mutex_;
+  bool windowed_warned_ = false;  ///< the fallback-window message was given (publish_mutex_)
 
   std::unique_ptr<diagnostic_updater::Updater> updater_;
   std::vector<std::unique_ptr<diagnostic_updater::FrequencyStatus>> freq_;
 
   std::unique_ptr<ReconfigureServer> reconfigure_;
 
-  std::unique_ptr<wavog_fleet::FleetStream> fleet_stream_;  ///< null unless fleet_stream
-  std::unique_ptr<wavog_fleet::FleetReceiver> fleet_;       ///< wavog_fleet only
+  std::unique_ptr<wavog_fleet::FleetStream> fleet_stream_;      ///< null unless fleet_stream
+  std::unique_ptr<wavog_fleet::FleetReceiver> fleet_;           ///< wavog_fleet only
   std::unique_ptr<wavog_fleet::VehicleWindows> fleet_windows_;  ///< wavog_fleet, fleet_window > 0
 };
 

@@ -1,7 +1,8 @@
 // MappingRos's timers: the full publication of every layer with the ~status of the period that
 // ends (onPublishTimer -> publishAll, also called at the end of the input and by the services),
-// and map_updates (onUpdateTimer). The map is read under the lock; messages
-// are built and sent after it is released.
+// and map_updates (onUpdateTimer). Both run on wall time, so that they go on after a bag's clock
+// has stopped. The map is read under the lock; messages are built and sent after it is released,
+// still under publish_mutex_, which keeps each update after the `map` it refers to.
 #include <ros/ros.h>
 #include <tf2/exceptions.h>
 
@@ -14,25 +15,36 @@
 
 namespace wavog_ros {
 
-void MappingRos::Impl::onPublishTimer(const ros::TimerEvent&) { publishAll(); }
+void MappingRos::Impl::onPublishTimer(const ros::WallTimerEvent&) { publishAll(); }
 
 bool MappingRos::Impl::windowCentre(const char* consequence, double* cx, double* cy) {
   const RosParams& rp = config_.ros;
   *cx = *cy = 0.0;
-  if (rp.publish_window <= 0.0) return true;
+  std::string error;
   try {
     const auto t = buffer_->lookupTransform(rp.map_frame, rp.base_frame, ros::Time(0));
     *cx = t.transform.translation.x;
     *cy = t.transform.translation.y;
     return true;
   } catch (const tf2::TransformException& e) {
-    ROS_WARN_THROTTLE(kWarnPeriod, "%s: no pose of '%s' for publish_window, %s: %s",
-                      pnh_.getNamespace().c_str(), rp.base_frame.c_str(), consequence, e.what());
-    return false;
+    error = e.what();
   }
+  // No robot pose from tf: the sensor of the last scan stands in for it.
+  bool have_sensor = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    have_sensor = publisher_->lastSensor(cx, cy);
+  }
+  if (have_sensor || rp.publish_window <= 0.0) return true;  // whole layers need no centre
+  ROS_WARN_THROTTLE(kWarnPeriod, "%s: no pose of '%s' for publish_window and no scan yet, %s: %s",
+                    pnh_.getNamespace().c_str(), rp.base_frame.c_str(), consequence, error.c_str());
+  return false;
 }
 
 void MappingRos::Impl::publishAll() {
+  // One publication at a time, and never between a map_updates read and its publication: an
+  // update always refers to the last `map` sent.
+  std::lock_guard<std::mutex> publishing(publish_mutex_);
   const auto t_start = std::chrono::steady_clock::now();
   const ros::Time now = ros::Time::now();
   const RosParams& rp = config_.ros;
@@ -44,8 +56,10 @@ void MappingRos::Impl::publishAll() {
   Layers layers;
   std::vector<wavog_fleet::VehicleWindows::Window> windows;
   wavog_mapping::MapperStatus::Ptr status;
+  wavog::GridValues values;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    values = rp.grid_values;
     if (fleet_windows_) {
       windows = fleet_windows_->readLocked(map_, [this](std::size_t i, double* x, double* y) {
         return fleet_->latestPositionLocked(i, x, y);
@@ -64,12 +78,23 @@ void MappingRos::Impl::publishAll() {
     for (const auto& r : layers.refused) text += " " + r + ";";
     ROS_ERROR_THROTTLE(kWarnPeriod,
                        "%s: layers not published, more than %.0f cells (the limit of one layer):%s "
-                       "set publish_window to publish a square around '%s'",
-                       pnh_.getNamespace().c_str(), kMaxLayerCells, text.c_str(),
-                       rp.base_frame.c_str());
+                       "make publish_window smaller",
+                       pnh_.getNamespace().c_str(), kMaxLayerCells, text.c_str());
   }
+  // Said once each time it starts: a layer too large as a whole goes out as a window.
+  if (!layers.windowed.empty() && !windowed_warned_) {
+    std::string text;
+    for (const auto& w : layers.windowed) text += " " + w + ";";
+    ROS_WARN(
+        "%s: the map has grown beyond %.0f cells (the limit of one layer):%s each such layer "
+        "is published as the square around '%s' (else the last scan's sensor) from now on; "
+        "the coarser layers stay whole while they fit (set publish_window to choose the "
+        "square)",
+        pnh_.getNamespace().c_str(), kMaxLayerCells, text.c_str(), rp.base_frame.c_str());
+  }
+  if (window_ok) windowed_warned_ = !layers.windowed.empty();
   MapPublisher::publish(layers, rp.map_frame, now);
-  wavog_fleet::VehicleWindows::publish(windows, rp.map_frame, now);
+  wavog_fleet::VehicleWindows::publish(windows, values, rp.map_frame, now);
   status_pub_.publish(status);
   if (fleet_) fleet_->publishStatus(now);
   const double elapsed =
@@ -121,24 +146,28 @@ wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time&
   return status;
 }
 
-void MappingRos::Impl::onUpdateTimer(const ros::TimerEvent&) {
+void MappingRos::Impl::onUpdateTimer(const ros::WallTimerEvent&) {
+  std::lock_guard<std::mutex> publishing(publish_mutex_);  // see publishAll()
   const ros::Time now = ros::Time::now();
+  wavog::GridValues values;
   if (fleet_windows_) {
     std::vector<wavog_fleet::VehicleWindows::Window> updates;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      values = config_.ros.grid_values;
       updates = fleet_windows_->readUpdatesLocked(map_);
     }
-    wavog_fleet::VehicleWindows::publishUpdates(updates, config_.ros.map_frame, now);
+    wavog_fleet::VehicleWindows::publishUpdates(updates, values, config_.ros.map_frame, now);
   }
   if (!publisher_->updateWanted()) return;
   wavog::Raster raster;
   wavog::CellBox full;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    values = config_.ros.grid_values;
     if (!publisher_->readUpdate(map_, &raster, &full)) return;
   }
-  publisher_->publishUpdate(raster, full, config_.ros.map_frame, now);
+  publisher_->publishUpdate(raster, full, values, config_.ros.map_frame, now);
 }
 
 }  // namespace wavog_ros

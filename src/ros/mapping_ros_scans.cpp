@@ -271,6 +271,7 @@ void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& 
                        static_cast<double>(st.touched.min_y) * res,
                        static_cast<double>(st.touched.max_x) * res,
                        static_cast<double>(st.touched.max_y) * res});
+  publisher_->sensorAt(pose.x, pose.y);
 }
 
 void MappingRos::Impl::dropLocked(Input* in, DropReason reason, const std::string& detail) {

@@ -59,11 +59,14 @@ void MappingRos::Impl::advertiseServices() {
 }
 
 bool MappingRos::Impl::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  map_.reset();
-  publisher_->markAllDirty(map_.resolution());
-  changed_since_publish_ = true;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    map_.reset();
+    publisher_->markAllDirty(map_.resolution());
+    changed_since_publish_ = true;
+  }
   ROS_INFO("%s: map reset", pnh_.getNamespace().c_str());
+  publishAll();  // now, not at the next timer: after a bag the clock may have stopped
   return true;
 }
 
@@ -75,12 +78,15 @@ bool MappingRos::Impl::onClearRegion(wavog_mapping::ClearRegion::Request& req,
     res.message = "the box must be finite with min <= max";
     return true;
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  map_.clearBox(req.min_x, req.min_y, req.max_x, req.max_y);
-  publisher_->touched({req.min_x, req.min_y, req.max_x, req.max_y});
-  changed_since_publish_ = true;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    map_.clearBox(req.min_x, req.min_y, req.max_x, req.max_y);
+    publisher_->touched({req.min_x, req.min_y, req.max_x, req.max_y});
+    changed_since_publish_ = true;
+  }
+  publishAll();  // as onReset
   res.success = true;
-  res.message = "cleared";
+  res.message = "cleared; published";
   return true;
 }
 
@@ -109,9 +115,11 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
   // forever).
   flushPending();
   std::vector<wavog::Raster> rasters;
-  std::string refused;  // layers too large for an image
+  std::string refused;         // layers too large for an image
+  wavog::RenderOptions image;  // map_server images with the published values and thresholds
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    image.values = config_.ros.grid_values;
     try {
       map_.save(req.path);
     } catch (const wavog::MapIoError& e) {
@@ -138,7 +146,7 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
     for (const wavog::Raster& r : rasters) {
       const std::string base = wavog::scaleFileBase(stem, r.scale);
       res.files.push_back(base + ".pgm");
-      res.files.push_back(wavog::writeMapServerMap(base, r));
+      res.files.push_back(wavog::writeMapServerMap(base, r, image));
     }
   } catch (const std::exception& e) {
     return fail(e.what());
@@ -170,19 +178,20 @@ bool MappingRos::Impl::onDynamicMap(nav_msgs::GetMap::Response& res) {
   if (!windowCentre("dynamic_map not answered", &cx, &cy)) return false;
   const ros::Time now = ros::Time::now();
   wavog::Raster raster;
-  std::string refused;
+  std::string refused, windowed;
   LayerSize size = LayerSize::kEmpty;
+  wavog::GridValues values;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    size = readOccupancy(map_, 0, rp, cx, cy, &raster, &refused);
+    size = readOccupancy(map_, 0, rp, cx, cy, &raster, &refused, &windowed);
     if (size == LayerSize::kTooLarge) ++layers_refused_;
+    values = rp.grid_values;
   }
   if (size == LayerSize::kTooLarge) {
     ROS_ERROR_THROTTLE(kWarnPeriod,
                        "%s: dynamic_map refused: the map layer (%s) has more than %.0f cells (the "
-                       "limit of one layer); set publish_window to serve a square around '%s'",
-                       pnh_.getNamespace().c_str(), refused.c_str(), kMaxLayerCells,
-                       rp.base_frame.c_str());
+                       "limit of one layer); make publish_window smaller",
+                       pnh_.getNamespace().c_str(), refused.c_str(), kMaxLayerCells);
     return false;
   }
   if (raster.box.empty()) {  // as gmapping before its first map: nothing to serve yet
@@ -191,7 +200,7 @@ bool MappingRos::Impl::onDynamicMap(nav_msgs::GetMap::Response& res) {
                       rp.publish_window > 0.0 ? " in publish_window" : "");
     return false;
   }
-  res.map = std::move(*toOccupancyGridMsg(raster, rp.map_frame, now));
+  res.map = std::move(*toOccupancyGridMsg(raster, values, rp.map_frame, now));
   return true;
 }
 

@@ -9,8 +9,8 @@
 namespace wavog_ros {
 namespace {
 
-/// One number of cfg/Mapping.cfg and where it lives in Config; "scales", "policy" and "init"
-/// (strings) are the other run-time parameters.
+/// One number of cfg/Mapping.cfg and where it lives in Config; "scales", "policy", "init",
+/// "map_values" and "scale_aggregation" (strings) are the other run-time parameters.
 struct NumberField {
   double wavog_mapping::MappingConfig::*reconfigure;
   double& (*in)(Config&);
@@ -30,6 +30,10 @@ const NumberField kNumbers[] = {
      [](Config& c) -> double& { return c.map.sensor.odd_emp; }},
     {&wavog_mapping::MappingConfig::publish_rate,
      [](Config& c) -> double& { return c.ros.publish_rate; }},
+    {&wavog_mapping::MappingConfig::occupied_thresh,
+     [](Config& c) -> double& { return c.ros.grid_values.occupied_thresh; }},
+    {&wavog_mapping::MappingConfig::free_thresh,
+     [](Config& c) -> double& { return c.ros.grid_values.free_thresh; }},
 };
 
 }  // namespace
@@ -41,6 +45,8 @@ wavog_mapping::MappingConfig toReconfigure(const Config& config) {
   rc.scales = joinScales(c.ros.publish_scales);
   rc.policy = wavog::toString(c.map.policy.type);
   rc.init = wavog::toString(c.map.policy.init);
+  rc.map_values = c.ros.grid_values.trinary ? "trinary" : "graded";
+  rc.scale_aggregation = toString(c.ros.scale_aggregation);
   return rc;
 }
 
@@ -57,6 +63,15 @@ Config withReconfigure(const Config& config, const wavog_mapping::MappingConfig&
   }
   if (!wavog::fromString(rc.init, &next.map.policy.init)) {
     errors->push_back("init ('" + rc.init + "') must be one of: unknown, empty_bound");
+  }
+  if (rc.map_values == "trinary" || rc.map_values == "graded") {
+    next.ros.grid_values.trinary = rc.map_values == "trinary";
+  } else {
+    errors->push_back("map_values ('" + rc.map_values + "') must be one of: trinary, graded");
+  }
+  if (!fromString(rc.scale_aggregation, &next.ros.scale_aggregation)) {
+    errors->push_back("scale_aggregation ('" + rc.scale_aggregation +
+                      "') must be one of: max, mean");
   }
   for (const auto& e : next.map.validate()) errors->push_back(e);
   for (const auto& e : validate(next.ros, next.map)) errors->push_back(e);

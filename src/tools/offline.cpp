@@ -224,7 +224,10 @@ Json writeScales(const Options& o, const wavog_ros::Config& config, Session* ses
         wavog::cropToKnown(map->exportScale(scale, box, config.ros.scale_aggregation));
     const std::string base = wavog::scaleFileBase("map", scale);  // as ~save_map names them
     wavog::writePng((fs::path(o.out) / (base + ".png")).string(), wavog::renderRgb(raster));
-    wavog::writeMapServerMap((fs::path(o.out) / base).string(), raster);
+    // The map_server map carries the node's published values (map_values, the thresholds).
+    wavog::RenderOptions image;
+    image.values = config.ros.grid_values;
+    wavog::writeMapServerMap((fs::path(o.out) / base).string(), raster, image);
     Json entry = {{"scale", scale},
                   {"cell_size_m", raster.cell_size},
                   {"width", raster.box.width()},

@@ -41,16 +41,17 @@ sensor_msgs::LaserScan decodeScan(FuzzedDataProvider* in) {
   s.header.frame_id = kFrames[in->ConsumeIntegralInRange<std::size_t>(0, 4)];
   s.header.stamp.sec = hostileSec(in);
   s.header.stamp.nsec = hostileNsec(in);
-  const auto f = [in](double lo, double hi) { return static_cast<float>(hostileDouble(in, lo, hi)); };
+  const auto f = [in](double lo, double hi) {
+    return static_cast<float>(hostileDouble(in, lo, hi));
+  };
   s.angle_min = f(-3.2, 3.2);
   s.angle_increment = f(-0.1, 0.1);
   const std::size_t n = in->ConsumeIntegralInRange<std::size_t>(0, kMaxBeams);
   // angle_max consistent with the beam count most of the time, so that checkScan passes.
-  s.angle_max = in->ConsumeBool()
-                    ? static_cast<float>(static_cast<double>(s.angle_min) +
-                                         static_cast<double>(s.angle_increment) *
-                                             (static_cast<double>(n) - 1.0))
-                    : f(-3.2, 3.2);
+  s.angle_max = in->ConsumeBool() ? static_cast<float>(static_cast<double>(s.angle_min) +
+                                                       static_cast<double>(s.angle_increment) *
+                                                           (static_cast<double>(n) - 1.0))
+                                  : f(-3.2, 3.2);
   s.time_increment = in->ConsumeBool() ? f(-1e-3, 1e-3) : 1.0f / (75.0f * 360.0f);
   s.scan_time = f(0.0, 1.0);
   s.range_min = f(0.0, 1.0);
@@ -168,10 +169,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                      "layer of %g cells accepted", cells);
     if (cells > kReadOutCells) continue;  // harness speed, not a limit of the node
     const wavog::Raster r = map.exportScale(s, box, wavog::Aggregation::kMean);
-    const auto msg = wavog_ros::toOccupancyGridMsg(r, "map", ros::Time(1, 0));
-    WAVOG_FUZZ_CHECK(msg->data.size() == static_cast<std::size_t>(msg->info.width) * msg->info.height,
-                     "grid of %zu values for %u x %u", msg->data.size(), msg->info.width,
-                     msg->info.height);
+    wavog::GridValues values;
+    values.trinary = (s & 1) == 0;  // both kinds of values
+    const auto msg = wavog_ros::toOccupancyGridMsg(r, values, "map", ros::Time(1, 0));
+    WAVOG_FUZZ_CHECK(
+        msg->data.size() == static_cast<std::size_t>(msg->info.width) * msg->info.height,
+        "grid of %zu values for %u x %u", msg->data.size(), msg->info.width, msg->info.height);
+    for (const std::int8_t v : msg->data) {
+      WAVOG_FUZZ_CHECK(v == -1 || (values.trinary ? (v == 0 || v == 100) : (v >= 0 && v <= 100)),
+                       "grid value %d (trinary %d)", static_cast<int>(v),
+                       static_cast<int>(values.trinary));
+    }
   }
   return 0;
 }

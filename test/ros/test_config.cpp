@@ -62,6 +62,9 @@ void expectSame(const Config& a, const Config& b) {
   EXPECT_EQ(a.ros.publish_rate, b.ros.publish_rate);
   EXPECT_EQ(a.ros.publish_scales, b.ros.publish_scales);
   EXPECT_EQ(a.ros.scale_aggregation, b.ros.scale_aggregation);
+  EXPECT_EQ(a.ros.grid_values.trinary, b.ros.grid_values.trinary);
+  EXPECT_EQ(a.ros.grid_values.occupied_thresh, b.ros.grid_values.occupied_thresh);
+  EXPECT_EQ(a.ros.grid_values.free_thresh, b.ros.grid_values.free_thresh);
   EXPECT_EQ(a.ros.publish_window, b.ros.publish_window);
   EXPECT_EQ(a.ros.fleet_stream_format, b.ros.fleet_stream_format);
   EXPECT_EQ(a.ros.update_rate, b.ros.update_rate);
@@ -177,8 +180,9 @@ TEST(Config, FleetRegionIsTheCoresBlockRegionOrAClearError) {
   EXPECT_NE(errorOf("{fleet_region: [0, 0, .nan, 1]}").find("fleet_region"), std::string::npos);
   EXPECT_NE(errorOf("{fleet_region: 3}").find("'fleet_region'"), std::string::npos);
   // Beyond the extent: the core's rule names it.
-  EXPECT_NE(errorOf("{resolution: 1, block_levels: 2, fleet_region: [0, 0, 4e9, 4]}").find("region"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf("{resolution: 1, block_levels: 2, fleet_region: [0, 0, 4e9, 4]}").find("region"),
+      std::string::npos);
 }
 
 TEST(Config, FleetWindowIsBoundedByTheLayerLimit) {
@@ -226,6 +230,11 @@ TEST(Config, BadValuesNameTheParameterAndItsRange) {
   EXPECT_NE(errorOf("map_frame: /map").find("map_frame"), std::string::npos);
   EXPECT_NE(errorOf("policy: forgetful").find("policy"), std::string::npos);
   EXPECT_NE(errorOf("scale_aggregation: median").find("mean, max"), std::string::npos);
+  EXPECT_NE(errorOf("map_values: binary").find("trinary, graded"), std::string::npos);
+  EXPECT_NE(errorOf("occupied_thresh: 0.4").find("occupied_thresh (0.4) must be in [0.5, 1]"),
+            std::string::npos);
+  EXPECT_NE(errorOf("free_thresh: .nan").find("free_thresh (nan) must be in [0, 0.5]"),
+            std::string::npos);
   EXPECT_NE(errorOf("resolution: abc").find("'resolution'"), std::string::npos);
   EXPECT_NE(errorOf("queue_size: 2.5").find("integer"), std::string::npos);
   EXPECT_NE(errorOf("max_sensor_speed: 0").find("max_sensor_speed (0) must be in (0, 1000] m/s"),

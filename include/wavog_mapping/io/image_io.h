@@ -1,7 +1,8 @@
 // Map pictures: 8-bit grey or RGB images written as PNG (libpng) or PGM, rendering of a
 // wavog::Raster (known cells in grey levels from P(occ), unknown in a distinct colour), and the
 // map_server pair (PGM + YAML). Image rows run top to bottom (north up): row 0 holds the raster's
-// highest y. Free functions without state: thread-safe. Lives in wavog_io (std, zlib, libpng; no ROS).
+// highest y. Free functions without state: thread-safe. Lives in wavog_io (std, zlib, libpng; no
+// ROS).
 #ifndef WAVOG_MAPPING_IO_IMAGE_IO_H_
 #define WAVOG_MAPPING_IO_IMAGE_IO_H_
 
@@ -55,6 +56,10 @@ struct RenderOptions {
   std::uint8_t unknown_grey = 205;
   /// Pixels per raster cell (>= 1), for small maps that should be seen.
   int upscale = 1;
+  /// Grey renderings and map_server images: graded (greyFromLogOdds, the default), or with
+  /// values.trinary the published values: occupied 0, free 254, between unknown_grey. A map_server
+  /// YAML states values.occupied_thresh and values.free_thresh.
+  GridValues values{false, 0.65, 0.196};
 };
 
 /// Grey level of a known cell: 254 (free, P = 0) down to 0 (occupied, P = 1), linear in P(occ).
@@ -93,7 +98,8 @@ struct MapServerYaml {
 void writeMapServerYaml(const std::string& path, const MapServerYaml& yaml);
 
 /// Writes `<base>.pgm` (renderGrey) and `<base>.yaml` (image name, resolution = raster cell size,
-/// origin = raster origin) so that `map_server <base>.yaml` serves the raster, unknown as -1.
+/// origin = raster origin, options.values' thresholds) so that `map_server <base>.yaml` serves the
+/// raster, unknown as -1: with options.values.trinary, the very values the mapper publishes.
 /// Returns the YAML path. Throws std::runtime_error.
 std::string writeMapServerMap(const std::string& base, const Raster& raster,
                               const RenderOptions& options = RenderOptions());

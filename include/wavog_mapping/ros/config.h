@@ -40,8 +40,13 @@ struct RosParams {
   /// Scales s published as map_scale_<s> (cells 2^s times the resolution), each in
   /// [1, block_levels], distinct; may be empty.
   std::vector<int> publish_scales = {2, 3, 4};
-  /// How a coarse cell summarises its finest cells.
-  wavog::Aggregation scale_aggregation = wavog::Aggregation::kMean;
+  /// How a coarse cell summarises its finest cells: max (a coarse cell holding an occupied finest
+  /// cell is occupied: what planners need) or mean (the Haar average).
+  wavog::Aggregation scale_aggregation = wavog::Aggregation::kMax;
+  /// Values of map, map_scale_<s>, map_updates, dynamic_map, the fleet windows and the saved
+  /// map_server images (keys map_values: trinary | graded, occupied_thresh, free_thresh): trinary
+  /// 0 / 100 / -1 by default, as map_server, amcl and costmap_2d read them.
+  wavog::GridValues grid_values;
   /// Half-width (m) of the square around base_frame that is published, >= 0; 0: the whole map.
   double publish_window = 0.0;
   /// Rate (Hz) of map_updates (changed rectangle of the finest layer), in [0, 100]; 0: off.

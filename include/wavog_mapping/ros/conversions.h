@@ -130,8 +130,9 @@ LayerSize layerBox(const wavog::WaveletMap& map, int scale, double window, doubl
                    wavog::CellBox* box);
 
 /// The raster as an OccupancyGrid in `frame` (origin = raster origin, identity orientation,
-/// row-major from the lowest y, -1 unknown, 0..100 graded).
+/// row-major from the lowest y), its values by `values` (trinary 0 / 100 / -1, or graded).
 nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::Raster& raster,
+                                                const wavog::GridValues& values,
                                                 const std::string& frame, const ros::Time& stamp);
 /// Reflection probabilities as an OccupancyGrid (0..100 from p, -1 where never observed).
 nav_msgs::OccupancyGrid::Ptr toOccupancyGridMsg(const wavog::ReflectionRaster& raster,
@@ -163,11 +164,9 @@ sensor_msgs::PointCloud2::Ptr toNdtCloud(const wavog::NdtLayer& layer, const std
 
 /// The raster as an update of a grid whose cell (0, 0) is the scale-s cell (grid_min_x,
 /// grid_min_y): x, y are the raster's offsets in that grid.
-map_msgs::OccupancyGridUpdate::Ptr toOccupancyGridUpdateMsg(const wavog::Raster& raster,
-                                                            std::int64_t grid_min_x,
-                                                            std::int64_t grid_min_y,
-                                                            const std::string& frame,
-                                                            const ros::Time& stamp);
+map_msgs::OccupancyGridUpdate::Ptr toOccupancyGridUpdateMsg(
+    const wavog::Raster& raster, std::int64_t grid_min_x, std::int64_t grid_min_y,
+    const wavog::GridValues& values, const std::string& frame, const ros::Time& stamp);
 
 }  // namespace wavog_ros
 

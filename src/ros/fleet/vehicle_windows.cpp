@@ -15,8 +15,8 @@ VehicleWindows::VehicleWindows(ros::NodeHandle nh, const std::vector<std::string
     : half_width_(half_width) {
   for (const std::string& name : vehicles) {
     Vehicle v;
-    v.map_pub = nh.advertise<nav_msgs::OccupancyGrid>(ros::names::append(name, "fleet_map"), 1,
-                                                      true);
+    v.map_pub =
+        nh.advertise<nav_msgs::OccupancyGrid>(ros::names::append(name, "fleet_map"), 1, true);
     v.update_pub = nh.advertise<map_msgs::OccupancyGridUpdate>(
         ros::names::append(name, "fleet_map_updates"), 10);
     vehicles_.push_back(v);
@@ -69,16 +69,19 @@ std::vector<VehicleWindows::Window> VehicleWindows::readUpdatesLocked(
   return out;
 }
 
-void VehicleWindows::publish(const std::vector<Window>& windows, const std::string& frame,
-                             const ros::Time& stamp) {
-  for (const Window& w : windows) w.pub.publish(wavog_ros::toOccupancyGridMsg(w.raster, frame, stamp));
+void VehicleWindows::publish(const std::vector<Window>& windows, const wavog::GridValues& values,
+                             const std::string& frame, const ros::Time& stamp) {
+  for (const Window& w : windows) {
+    w.pub.publish(wavog_ros::toOccupancyGridMsg(w.raster, values, frame, stamp));
+  }
 }
 
-void VehicleWindows::publishUpdates(const std::vector<Window>& updates, const std::string& frame,
+void VehicleWindows::publishUpdates(const std::vector<Window>& updates,
+                                    const wavog::GridValues& values, const std::string& frame,
                                     const ros::Time& stamp) {
   for (const Window& w : updates) {
-    w.pub.publish(
-        wavog_ros::toOccupancyGridUpdateMsg(w.raster, w.full.min_x, w.full.min_y, frame, stamp));
+    w.pub.publish(wavog_ros::toOccupancyGridUpdateMsg(w.raster, w.full.min_x, w.full.min_y, values,
+                                                      frame, stamp));
   }
 }
 

@@ -39,11 +39,11 @@ class VehicleWindows {
   std::vector<Window> readLocked(const wavog::WaveletMap& map, const PositionFn& position);
   /// The part of each vehicle's last window changed since the previous call (caller's lock).
   std::vector<Window> readUpdatesLocked(const wavog::WaveletMap& map);
-  /// Publish what the reads returned (no lock needed).
-  static void publish(const std::vector<Window>& windows, const std::string& frame,
-                      const ros::Time& stamp);
-  static void publishUpdates(const std::vector<Window>& updates, const std::string& frame,
-                             const ros::Time& stamp);
+  /// Publish what the reads returned, with the mapper's grid values (no lock needed).
+  static void publish(const std::vector<Window>& windows, const wavog::GridValues& values,
+                      const std::string& frame, const ros::Time& stamp);
+  static void publishUpdates(const std::vector<Window>& updates, const wavog::GridValues& values,
+                             const std::string& frame, const ros::Time& stamp);
 
  private:
   struct Vehicle {
