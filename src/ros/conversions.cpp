@@ -33,9 +33,9 @@ bool clip(double clip_lo, double clip_hi, double* lo, double* hi) {
 const char* toString(DropReason reason) {
   // In DropReason order.
   static constexpr const char* kNames[kNumDropReasons] = {
-      "empty",         "bad_angles",   "bad_frame",     "tf_unavailable",
-      "tf_too_old",    "no_valid_beam", "bad_geometry", "out_of_extent",
-      "absurd_pose",   "bad_time",      "exception"};
+      "empty",       "bad_angles",    "bad_frame",    "tf_unavailable",
+      "tf_too_old",  "no_valid_beam", "bad_geometry", "out_of_extent",
+      "absurd_pose", "bad_time",      "exception",    "bad_length"};
   const auto i = static_cast<std::size_t>(reason);
   return i < kNumDropReasons ? kNames[i] : "unknown";
 }

@@ -26,9 +26,9 @@
 #include <string>
 #include <vector>
 
+#include "checked_subscription.h"
 #include "input_status.h"
 #include "map_publisher.h"
-#include "wavog_mapping/ros/pose_check.h"
 #include "reconfigure.h"
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"
@@ -39,6 +39,7 @@
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/ros/config.h"
 #include "wavog_mapping/ros/mapping_ros.h"
+#include "wavog_mapping/ros/pose_check.h"
 #include "wavog_mapping/ros/scan_placement.h"
 
 namespace wavog_fleet {
@@ -112,6 +113,10 @@ struct MappingRos::Impl {
   // ---- one scan (mapping_ros_scans.cpp), in the order a scan passes them
   /// `connection`: an opaque id of the connection the scan came through (SeqGapCounter).
   void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan, std::uintptr_t connection);
+  /// A scan refused before deserialisation (checked_subscription.h: an array longer than the
+  /// message's bytes, or truncated): received, dropped as bad_length, warned; `partial.header`
+  /// counts lost scans when it was read.
+  void onRefusedScan(Input* in, const sensor_msgs::LaserScan& partial, const Refused& refused);
   /// Counts the scans missing before `scan` (header.seq gaps) and warns. Under mutex_.
   void countLostLocked(Input* in, const sensor_msgs::LaserScan& scan, std::uintptr_t connection);
   /// Counts and warns about a checked scan that is integrated all the same: a range count that

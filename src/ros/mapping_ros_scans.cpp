@@ -112,6 +112,23 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
   in->filter->add(scan);
 }
 
+void MappingRos::Impl::onRefusedScan(Input* in, const sensor_msgs::LaserScan& partial,
+                                     const Refused& refused) {
+  if (in->freq) in->freq->tick();
+  noteActivity();
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++in->c[Counter::kReceived];
+  ++in->c.received_in_period;
+  in->c.last_receipt = ros::Time::now();
+  // header.seq is the message's first field: read unless the message is shorter than 4 bytes.
+  if (refused.bytes_read >= sizeof(partial.header.seq)) {
+    countLostLocked(in, partial, refused.connection);
+  }
+  dropLocked(in, DropReason::kBadLength,
+             "a message of " + std::to_string(refused.length) +
+                 " bytes refused before deserialisation: " + refused.why);
+}
+
 void MappingRos::Impl::countLostLocked(Input* in, const sensor_msgs::LaserScan& scan,
                                        std::uintptr_t connection) {
   const std::uint32_t lost = in->c.seq.next(scan.header.seq, connection);

@@ -77,10 +77,10 @@ class TfBursts {
 
 /// Scans of the input dropped for any reason.
 std::uint64_t droppedScans(const wavog_mapping::InputStatus& in) {
-  return in.dropped_empty + in.dropped_bad_angles +
-         in.dropped_bad_frame + in.dropped_tf_unavailable + in.dropped_tf_too_old +
-         in.dropped_no_valid_beam + in.dropped_bad_geometry + in.dropped_out_of_extent +
-         in.dropped_absurd_pose + in.dropped_bad_time + in.dropped_exception;
+  return in.dropped_empty + in.dropped_bad_angles + in.dropped_bad_frame +
+         in.dropped_tf_unavailable + in.dropped_tf_too_old + in.dropped_no_valid_beam +
+         in.dropped_bad_geometry + in.dropped_out_of_extent + in.dropped_absurd_pose +
+         in.dropped_bad_time + in.dropped_exception + in.dropped_bad_length;
 }
 
 void onStatus(const wavog_mapping::MapperStatus::ConstPtr& s) {
