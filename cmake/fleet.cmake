@@ -107,6 +107,15 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet)
   add_dependencies(test_fleet_map_services ${PROJECT_NAME}_generate_messages_cpp wavog_fleet)
 endif()
 
+# ---- Forged array lengths to the mapper and wavog_fleet (test/forged_lengths.test, issue 42) ----
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet AND TARGET wavog_mapping_node)
+  add_rostest_gtest(test_forged_lengths test/forged_lengths.test test/ros/test_forged_lengths.cpp)
+  target_link_libraries(test_forged_lengths wavog_ros_includes ${catkin_LIBRARIES}
+                        ${GTEST_LIBRARIES})
+  add_dependencies(test_forged_lengths ${PROJECT_NAME}_generate_messages_cpp wavog_fleet
+                   wavog_mapping_node)
+endif()
+
 # ---- Region shards (test/fleet_shards.test, issue 36): 2 shards, 1 unsharded node, wavog_site ----
 if(CATKIN_ENABLE_TESTING AND TARGET wavog_sim)
   add_rostest_gtest(test_fleet_shards test/fleet_shards.test test/ros/test_fleet_shards.cpp)

@@ -75,6 +75,13 @@ if(CATKIN_ENABLE_TESTING)
     if(TARGET test_seq_gaps)
       target_link_libraries(test_seq_gaps wavog_ros ${GTEST_MAIN_LIBRARIES})
     endif()
+    # The inputs' checking deserialiser: forged array lengths refused before sizing (issue 42).
+    catkin_add_gtest(test_checked_deserialize test/ros/test_checked_deserialize.cpp)
+    if(TARGET test_checked_deserialize)
+      target_include_directories(test_checked_deserialize PRIVATE
+                                 ${CMAKE_CURRENT_SOURCE_DIR}/src/ros ${CMAKE_CURRENT_SOURCE_DIR}/test/ros)
+      target_link_libraries(test_checked_deserialize wavog_ros ${GTEST_MAIN_LIBRARIES})
+    endif()
     # Absurd poses from tf (issue 27) and other people's scan geometry: no master needed.
     catkin_add_gtest(test_pose_check test/ros/test_pose_check.cpp)
     if(TARGET test_pose_check)

@@ -82,6 +82,12 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_offline AND TARGET wavog_mapping_node
     set_tests_properties(_ctest_${PROJECT_NAME}_rostest_test_tools_playback.test PROPERTIES
                          FIXTURES_REQUIRED wavog_playback_bag LABELS "tools;rostest" TIMEOUT 300
                          ENVIRONMENT "WAVOG_PLAYBACK_BAG=${_wavog_playback_bag}")
+    # The same playback with the bag's /tf handed on in bursts (issue 42).
+    add_rostest(test/tools/playback_tf_bursts.test
+                DEPENDENCIES test_playback wavog_mapping_node wavog_offline)
+    set_tests_properties(_ctest_${PROJECT_NAME}_rostest_test_tools_playback_tf_bursts.test
+                         PROPERTIES FIXTURES_REQUIRED wavog_playback_bag LABELS "tools;rostest"
+                         TIMEOUT 300 ENVIRONMENT "WAVOG_PLAYBACK_BAG=${_wavog_playback_bag}")
   endif()
 endif()
 

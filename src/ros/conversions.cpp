@@ -35,7 +35,7 @@ const char* toString(DropReason reason) {
   static constexpr const char* kNames[kNumDropReasons] = {
       "empty",       "bad_angles",    "bad_frame",    "tf_unavailable",
       "tf_too_old",  "no_valid_beam", "bad_geometry", "out_of_extent",
-      "absurd_pose", "bad_time",      "exception"};
+      "absurd_pose", "bad_time",      "exception",    "bad_length"};
   const auto i = static_cast<std::size_t>(reason);
   return i < kNumDropReasons ? kNames[i] : "unknown";
 }

@@ -34,6 +34,8 @@ constexpr CounterRow kRows[] = {
     {droppedCounter(DropReason::kBadTime), "dropped bad_time", &InputStatus::dropped_bad_time},
     {droppedCounter(DropReason::kException), "dropped exception",
      &InputStatus::dropped_exception},
+    {droppedCounter(DropReason::kBadLength), "dropped bad_length",
+     &InputStatus::dropped_bad_length},
     {Counter::kTimeJumps, "time jumps", &InputStatus::time_jumps},
     {Counter::kMotionFallbacks, "motion fallbacks", &InputStatus::motion_fallbacks},
     {Counter::kIntegratedLatestTf, "integrated with latest tf", &InputStatus::integrated_latest_tf},

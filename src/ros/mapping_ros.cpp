@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "checked_subscription.h"
 #include "fleet/fleet_receiver.h"
 #include "fleet/fleet_stream.h"
 #include "fleet/vehicle_windows.h"
@@ -151,8 +152,10 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
   // onScan counts from the gaps in header.seq per connection (the event's connection header,
   // by address only: MessageEvent::getPublisherName() uses the map's operator[], which
   // ThreadSanitizer shows racing with roscpp dropping the connection).
-  in->sub = nh_.subscribe<LaserScan>(
-      ic.topic, static_cast<std::uint32_t>(rp.subscriber_queue_size),
+  // Deserialised with every array length checked against the message's bytes first (issue 42):
+  // a forged length prefix is counted as bad_length instead of sizing ranges to it.
+  in->sub = subscribeChecked<LaserScan>(
+      nh_, ic.topic, static_cast<std::uint32_t>(rp.subscriber_queue_size),
       boost::function<void(const ros::MessageEvent<const LaserScan>&)>(
           [this, raw](const ros::MessageEvent<const LaserScan>& event) {
             guarded("scan callback", raw, [&] {
@@ -160,7 +163,9 @@ void MappingRos::Impl::addInput(const InputConfig& ic) {
                      reinterpret_cast<std::uintptr_t>(event.getConnectionHeaderPtr().get()));
             });
           }),
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+      [this, raw](const LaserScan& partial, const Refused& r) {
+        guarded("scan deserialisation", nullptr, [&] { onRefusedScan(raw, partial, r); });
+      });
   updater_->add(in->topic + " input", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {
     diagnoseInput(raw, s);
   });

@@ -53,22 +53,28 @@ std::size_t MappingRos::Impl::flushPending() {
     std::lock_guard<std::mutex> tf_lock(tf_mutex_);
     for (auto& in : inputs_) in->filter->clear();
   }
-  std::vector<std::pair<Input*, sensor_msgs::LaserScan::ConstPtr>> waiting;
+  std::vector<std::pair<Input*, PendingScan>> waiting;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto& in : inputs_) {
-      for (auto& scan : in->pending) waiting.emplace_back(in.get(), std::move(scan));
+      for (auto& p : in->pending) waiting.emplace_back(in.get(), std::move(p));
       in->pending.clear();
     }
   }
   // No newer tf is coming: the scan is placed by the newest transform of its frame, without
-  // motion compensation (there is no tf over its sweep).
+  // motion compensation (there is no tf over its sweep). The scans tf placed already, waiting
+  // for one received before them, keep their placement; all in the order received.
   PlacementOptions options = placement_;
   options.motion_compensation = false;
   std::size_t flushed = 0;
   for (auto& w : waiting) {
     Input* in = w.first;
-    auto scan = boost::make_shared<sensor_msgs::LaserScan>(*w.second);
+    if (w.second.placed) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      integratePlacedScanLocked(in, *w.second.scan, w.second.placement);
+      continue;
+    }
+    auto scan = boost::make_shared<sensor_msgs::LaserScan>(*w.second.scan);
     std::string error;
     try {
       const auto t =

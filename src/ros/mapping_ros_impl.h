@@ -20,11 +20,13 @@
 
 #include <array>
 #include <atomic>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include "checked_subscription.h"
 #include "input_status.h"
 #include "map_publisher.h"
 #include "reconfigure.h"
@@ -61,6 +63,13 @@ enum WarningSlot : std::size_t {
   kNumWarningSlots
 };
 
+/// A scan between the tf filter and the map (Input::pending).
+struct PendingScan {
+  sensor_msgs::LaserScan::ConstPtr scan;
+  bool placed = false;  ///< out of the filter: `placement` holds what tf said (or its failure)
+  ScanPlacement placement;  ///< valid when `placed`
+};
+
 /// One LaserScan input: its subscription, its tf filter and its counters.
 struct Input {
   InputConfig config;
@@ -78,10 +87,13 @@ struct Input {
   bool slash_warned = false;  ///< the leading-'/' warning was given (guarded by Impl::mutex_)
   wavog::ScanPeriod period;   ///< of this laser's scans, for forget_half_life (Impl::mutex_)
   PoseCheck poses;            ///< absurd poses from tf (Impl::mutex_)
-  /// Scans handed to the tf filter and not yet out of it (integrated, dropped or flushed), oldest
-  /// first; whoever removes a scan from here owns it. Guarded by Impl::mutex_. At most about
-  /// queue_size long: the filter reports every scan it drops.
-  std::vector<sensor_msgs::LaserScan::ConstPtr> pending;
+  /// Scans handed to the tf filter and not yet integrated, dropped or flushed, in the order they
+  /// were received; whoever removes a scan from here owns it. Guarded by Impl::mutex_. The filter
+  /// hands scans on from several threads in any order; they are integrated from the front only,
+  /// so in the order received, as wavog_offline does (issue 42). At most 2 x queue_size long: the
+  /// filter reports every scan it drops, and a scan that holds up more than queue_size placed ones
+  /// is dropped (releaseReadyLocked).
+  std::deque<PendingScan> pending;
 };
 
 struct MappingRos::Impl {
@@ -101,6 +113,10 @@ struct MappingRos::Impl {
   // ---- one scan (mapping_ros_scans.cpp), in the order a scan passes them
   /// `connection`: an opaque id of the connection the scan came through (SeqGapCounter).
   void onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan, std::uintptr_t connection);
+  /// A scan refused before deserialisation (checked_subscription.h: an array longer than the
+  /// message's bytes, or truncated): received, dropped as bad_length, warned; `partial.header`
+  /// counts lost scans when it was read.
+  void onRefusedScan(Input* in, const sensor_msgs::LaserScan& partial, const Refused& refused);
   /// Counts the scans missing before `scan` (header.seq gaps) and warns. Under mutex_.
   void countLostLocked(Input* in, const sensor_msgs::LaserScan& scan, std::uintptr_t connection);
   /// Counts and warns about a checked scan that is integrated all the same: a range count that
@@ -110,8 +126,14 @@ struct MappingRos::Impl {
   void onFilterFailure(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
                        tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onTransformable(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan);
-  /// Removes `scan` from in->pending; false if it was not there (flushed or already handled).
-  bool takePendingLocked(Input* in, const sensor_msgs::LaserScan* scan);
+  /// The entry of `scan` in in->pending; null if it is not there (flushed or already handled).
+  PendingScan* findPendingLocked(Input* in, const sensor_msgs::LaserScan* scan);
+  /// Integrates (or drops) the placed scans at the front of in->pending, in the order received,
+  /// up to the first one still waiting for tf. Returns how many left the queue.
+  std::size_t releaseReadyLocked(Input* in);
+  /// A scan tf has placed (or failed to): dropped, or integrated with its placement.
+  void integratePlacedScanLocked(Input* in, const sensor_msgs::LaserScan& scan,
+                                 const ScanPlacement& placement);
   void integrateLocked(Input* in, const sensor_msgs::LaserScan& scan,
                        const ScanPlacement& placement);
   void dropLocked(Input* in, DropReason reason, const std::string& detail);

@@ -101,7 +101,8 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
       dropLocked(in, reason, detail.str());
       return;
     }
-    in->pending.push_back(scan);  // before the filter may hand it on
+    // Before the filter may hand it on.
+    in->pending.push_back(PendingScan{scan, false, ScanPlacement()});
   }
   std::lock_guard<std::mutex> tf_lock(tf_mutex_);
   if (clear_tf) {
@@ -109,6 +110,23 @@ void MappingRos::Impl::onScan(Input* in, const sensor_msgs::LaserScan::ConstPtr&
     buffer_->clear();
   }
   in->filter->add(scan);
+}
+
+void MappingRos::Impl::onRefusedScan(Input* in, const sensor_msgs::LaserScan& partial,
+                                     const Refused& refused) {
+  if (in->freq) in->freq->tick();
+  noteActivity();
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++in->c[Counter::kReceived];
+  ++in->c.received_in_period;
+  in->c.last_receipt = ros::Time::now();
+  // header.seq is the message's first field: read unless the message is shorter than 4 bytes.
+  if (refused.bytes_read >= sizeof(partial.header.seq)) {
+    countLostLocked(in, partial, refused.connection);
+  }
+  dropLocked(in, DropReason::kBadLength,
+             "a message of " + std::to_string(refused.length) +
+                 " bytes refused before deserialisation: " + refused.why);
 }
 
 void MappingRos::Impl::countLostLocked(Input* in, const sensor_msgs::LaserScan& scan,
@@ -182,7 +200,12 @@ void MappingRos::Impl::onFilterFailure(
     Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
     tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!takePendingLocked(in, scan.get())) return;  // already flushed
+  auto& pending = in->pending;
+  const auto it = std::find_if(pending.begin(), pending.end(),
+                               [&scan](const PendingScan& p) { return p.scan == scan; });
+  if (it == pending.end()) return;  // already flushed
+  // Dropped now, not in its turn: a drop changes no map, so its order does not matter.
+  pending.erase(it);
   if (reason == tf2_ros::filter_failure_reasons::OutTheBack) {
     dropLocked(in, DropReason::kTfTooOld, "stamp older than the tf buffer");
   } else if (reason == tf2_ros::filter_failure_reasons::EmptyFrameID) {
@@ -195,34 +218,71 @@ void MappingRos::Impl::onFilterFailure(
                    "' (unknown frame, tf late, or more than queue_size " +
                    std::to_string(config_.ros.queue_size) + " scans waiting for tf)");
   }
+  releaseReadyLocked(in);  // the scans this one held up
 }
 
 void MappingRos::Impl::onTransformable(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan) {
-  // tf lookups outside the lock: the buffer locks itself.
+  // tf lookups outside the lock: the buffer locks itself. The filter calls this from any of the
+  // spinner's threads, several scans at once when tf comes late and in bursts (a loaded host):
+  // the placement is kept, and the scan waits in in->pending for those received before it.
   const ScanPlacement placement = placeScan(*buffer_, *scan, placement_);
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!takePendingLocked(in, scan.get())) return;  // flushed meanwhile (flushPending)
-    if (!placement.placed()) {
-      dropLocked(in, DropReason::kTfUnavailable, placement.error);
-      return;
-    }
-    if (placement.motion_fallback) {
-      ++in->c[Counter::kMotionFallbacks];
-      warnLocked(in, kOtherWarning, "no tf at the end of the sweep: motion compensation skipped");
-    }
-    integrateLocked(in, *scan, placement);
+    PendingScan* p = findPendingLocked(in, scan.get());
+    if (p == nullptr) return;  // flushed meanwhile (flushPending)
+    p->placed = true;
+    p->placement = placement;
+    releaseReadyLocked(in);
   }
   if (fleet_stream_) fleet_stream_->publishQueued();  // without the lock
 }
 
-bool MappingRos::Impl::takePendingLocked(Input* in, const sensor_msgs::LaserScan* scan) {
+PendingScan* MappingRos::Impl::findPendingLocked(Input* in, const sensor_msgs::LaserScan* scan) {
   auto& p = in->pending;
-  const auto it =
-      std::find_if(p.begin(), p.end(), [scan](const auto& s) { return s.get() == scan; });
-  if (it == p.end()) return false;
-  p.erase(it);
-  return true;
+  const auto it = std::find_if(p.begin(), p.end(),
+                               [scan](const PendingScan& s) { return s.scan.get() == scan; });
+  return it == p.end() ? nullptr : &*it;
+}
+
+std::size_t MappingRos::Impl::releaseReadyLocked(Input* in) {
+  auto& p = in->pending;
+  std::size_t n = 0;
+  // A scan tf cannot place while more than queue_size scans behind it are placed (tf for its
+  // frame alone missing; the filter, holding only it, never overflows) no longer holds them up.
+  // One that tf can place is on its way here (a spinner thread between the filter and
+  // onTransformable), however long its thread is descheduled: it is waited for.
+  const std::size_t limit = 2 * static_cast<std::size_t>(config_.ros.queue_size);
+  while (!p.empty() && !p.front().placed && p.size() > limit &&
+         !buffer_->canTransform(
+             placement_.fixed_frame, p.front().scan->header.frame_id,
+             p.front().scan->header.stamp + ros::Duration(config_.ros.tf_tolerance))) {
+    p.pop_front();
+    ++n;
+    dropLocked(in, DropReason::kTfUnavailable,
+               "no transform to '" + placement_.fixed_frame + "' while " +
+                   std::to_string(config_.ros.queue_size) +
+                   " (queue_size) later scans were placed");
+  }
+  while (!p.empty() && p.front().placed) {
+    const PendingScan next = std::move(p.front());
+    p.pop_front();
+    ++n;
+    integratePlacedScanLocked(in, *next.scan, next.placement);
+  }
+  return n;
+}
+
+void MappingRos::Impl::integratePlacedScanLocked(Input* in, const sensor_msgs::LaserScan& scan,
+                                                 const ScanPlacement& placement) {
+  if (!placement.placed()) {
+    dropLocked(in, DropReason::kTfUnavailable, placement.error);
+    return;
+  }
+  if (placement.motion_fallback) {
+    ++in->c[Counter::kMotionFallbacks];
+    warnLocked(in, kOtherWarning, "no tf at the end of the sweep: motion compensation skipped");
+  }
+  integrateLocked(in, scan, placement);
 }
 
 void MappingRos::Impl::integrateLocked(Input* in, const sensor_msgs::LaserScan& scan,

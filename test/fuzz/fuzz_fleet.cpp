@@ -280,7 +280,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const Vehicle& v : vehicles) {
     const wavog_mapping::VehicleStatus& c = v.c;
     const std::uint64_t refused = c.dropped_version + c.dropped_frame + c.dropped_bad_stamp +
-                                  c.dropped_bad_pose + c.dropped_bad_size;
+                                  c.dropped_bad_pose + c.dropped_bad_size + c.dropped_bad_length;
     WAVOG_FUZZ_CHECK(c.received == refused + v.queued + c.dropped_overflow + c.dropped_late +
                                        c.integrated_late,
                      "received %llu: refused %llu, queued %llu, overflow %llu, late %llu + %llu",

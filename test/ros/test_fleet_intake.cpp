@@ -139,3 +139,39 @@ TEST(FleetIntake, BothStreamVersionsAreReadAndAnyOtherRefused) {
 }
 
 }  // namespace
+
+namespace {
+
+// Issue 42: a message refused before deserialisation (an array longer than its bytes) is
+// delivered too: its index, when it was read, steps the sequence; one cut before its index does
+// not (the next message's gap then counts it as lost, as nothing says which index it had).
+TEST(FleetIntake, MessagesRefusedForTheirLengthAreDeliveredWhenTheirIndexWasRead) {
+  Stream s;
+  EXPECT_EQ(s.take(goodScan(0)).refusal, Refusal::kNone);
+  wavog_mapping::PlacedScan partial = goodScan(1);
+  partial.ranges.clear();  // as read up to the forged prefix
+  const std::uint64_t through_index = wavog_fleet::bytesThroughIndex(partial);
+  EXPECT_EQ(through_index, 1u + 12u + 4u + 3u + 4u + 2u + 4u + 8u + 8u);  // "map", "v1", "/v1/scan"
+  const wavog_fleet::Intake in =
+      wavog_fleet::takeInRefused(partial, static_cast<std::uint32_t>(through_index) + 100, 1600,
+                                 "an array claims", &s.index, &s.c);
+  EXPECT_EQ(in.refusal, Refusal::kBadLength);
+  EXPECT_EQ(in.step, IndexStep::kNext);
+  EXPECT_EQ(in.detail, "an array claims");
+  EXPECT_EQ(s.c.dropped_bad_length, 1u);
+  EXPECT_EQ(s.c.received, 2u);
+  EXPECT_EQ(s.c.bytes, ros::serialization::serializationLength(goodScan(0)) + 1600u);
+  // Cut inside its input string: index 2 not read, not stepped.
+  wavog_mapping::PlacedScan cut = goodScan(2);
+  cut.input.clear();
+  cut.index = 0;
+  wavog_fleet::takeInRefused(cut, static_cast<std::uint32_t>(through_index) - 12, 40, "ends",
+                             &s.index, &s.c);
+  EXPECT_EQ(s.c.dropped_bad_length, 2u);
+  EXPECT_EQ(s.c.index_regressions, 0u);  // the 0 it holds was not taken for an index
+  EXPECT_EQ(s.take(goodScan(3)).step, IndexStep::kGap);
+  EXPECT_EQ(s.c.lost, 1u);
+  EXPECT_EQ(s.c.received, 4u);
+}
+
+}  // namespace

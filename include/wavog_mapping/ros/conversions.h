@@ -32,8 +32,10 @@ enum class DropReason {
   kAbsurdPose,     ///< the laser's pose jumps faster than max_sensor_speed, or is not finite
   kBadTime,        ///< stamp or time_increment outside what ROS time arithmetic can represent
   kException,      ///< an exception was caught while handling the scan (logged)
+  kBadLength,      ///< an array longer than the message's bytes, or a truncated message:
+                   ///< refused before deserialisation sized anything (checked_subscription.h)
 };
-constexpr std::size_t kNumDropReasons = 11;
+constexpr std::size_t kNumDropReasons = 12;
 
 /// Longest sweep (s), |time_increment| x (beams - 1), of a scan that is accepted; a longer one, or
 /// a non-finite time_increment, is dropped as bad_time. Planar lasers sweep in 10-200 ms.

@@ -6,6 +6,7 @@
 #include <boost/make_shared.hpp>
 #include <stdexcept>
 
+#include "../checked_subscription.h"
 #include "intake.h"
 #include "wavog_mapping/ros/conversions.h"
 
@@ -67,8 +68,9 @@ FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
     v->c.vehicle = name;
     v->c.topic = v->topic;
     Vehicle* raw = v.get();
-    v->sub = nh_.subscribe<wavog_mapping::PlacedScan>(
-        v->topic, kSubscriberQueue,
+    // Checked deserialisation: no array is sized beyond the bytes a message carries (issue 42).
+    v->sub = wavog_ros::subscribeChecked<wavog_mapping::PlacedScan>(
+        nh_, v->topic, kSubscriberQueue,
         boost::function<void(const ros::MessageEvent<const wavog_mapping::PlacedScan>&)>(
             [this, raw](const ros::MessageEvent<const wavog_mapping::PlacedScan>& e) {
               try {
@@ -78,7 +80,14 @@ FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
                                    raw->topic.c_str(), ex.what());
               }
             }),
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+        [this, raw](const wavog_mapping::PlacedScan& partial, const wavog_ros::Refused& r) {
+          try {
+            onRefused(raw, partial, r);
+          } catch (const std::exception& ex) {
+            ROS_ERROR_THROTTLE(kWarnPeriod, "%s: exception counting a refused message: %s",
+                               raw->topic.c_str(), ex.what());
+          }
+        });
     updater->add(name + " vehicle", [this, raw](diagnostic_updater::DiagnosticStatusWrapper& s) {
       diagnose(raw, s);
     });
@@ -91,6 +100,16 @@ FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
 FleetReceiver::~FleetReceiver() {
   release_timer_.stop();
   for (auto& v : vehicles_) v->sub.shutdown();
+}
+
+void FleetReceiver::onRefused(Vehicle* v, const wavog_mapping::PlacedScan& partial,
+                              const wavog_ros::Refused& r) {
+  std::lock_guard<std::mutex> lock(*mutex_);
+  v->last_receipt = ros::WallTime::now();
+  takeInRefused(partial, r.bytes_read, r.length, r.why, &v->stream_index, &v->c);
+  warnLocked(v, "message of " + std::to_string(r.length) +
+                    " bytes refused before deserialisation (bad_length, " +
+                    std::to_string(v->c.dropped_bad_length) + " so far): " + r.why);
 }
 
 void FleetReceiver::onMessage(Vehicle* v,
@@ -239,7 +258,7 @@ void FleetReceiver::diagnose(const Vehicle* v, diagnostic_updater::DiagnosticSta
   const wavog_mapping::VehicleStatus& c = v->c;
   const std::uint64_t refused = c.dropped_version + c.dropped_frame + c.dropped_bad_stamp +
                                 c.dropped_bad_pose + c.dropped_bad_size + c.dropped_refused +
-                                c.dropped_overflow;
+                                c.dropped_overflow + c.dropped_bad_length;
   if (staleLocked(v, now)) {
     if (v->last_receipt.isZero()) {
       stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "stale: nothing received yet");
@@ -269,6 +288,7 @@ void FleetReceiver::diagnose(const Vehicle* v, diagnostic_updater::DiagnosticSta
   stat.add("dropped bad stamp", c.dropped_bad_stamp);
   stat.add("dropped bad pose", c.dropped_bad_pose);
   stat.add("dropped bad size", c.dropped_bad_size);
+  stat.add("dropped bad length", c.dropped_bad_length);
   stat.add("dropped refused by core", c.dropped_refused);
   stat.add("dropped overflow", c.dropped_overflow);
   stat.add("last stamp", c.last_stamp.toSec());

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "../checked_subscription.h"
 #include "placed_scan.h"
 #include "reorder_buffer.h"
 #include "stream_index.h"
@@ -60,6 +61,8 @@ class FleetReceiver {
   using Item = wavog_mapping::PlacedScan::ConstPtr;
 
   void onMessage(Vehicle* v, const ros::MessageEvent<const wavog_mapping::PlacedScan>& event);
+  /// A message refused before deserialisation (checked_subscription.h): counted, warned.
+  void onRefused(Vehicle* v, const wavog_mapping::PlacedScan& partial, const wavog_ros::Refused& r);
   void onReleaseTimer();
   void integrateLocked(Vehicle* v, const wavog_mapping::PlacedScan& m);
   void warnLocked(Vehicle* v, const std::string& text);

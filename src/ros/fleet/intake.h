@@ -31,6 +31,18 @@ struct Intake {
 Intake takeIn(const wavog_mapping::PlacedScan& m, const PlacedScanLimits& limits,
               const ros::Time& now, StreamIndex* index, wavog_mapping::VehicleStatus* c);
 
+/// Counts a message of `length` bytes refused before deserialisation (checked_subscription.h:
+/// an array longer than its bytes, or truncated) as received, its bytes, and dropped_bad_length;
+/// `partial` holds the fields read before the refusal, its first `bytes_read` bytes: when they
+/// include `index`, the index steps the sequence as takeIn() steps it (the message was delivered,
+/// so it is not lost). Never throws.
+Intake takeInRefused(const wavog_mapping::PlacedScan& partial, std::uint32_t bytes_read,
+                     std::uint32_t length, const std::string& why, StreamIndex* index,
+                     wavog_mapping::VehicleStatus* c);
+
+/// Bytes of a serialised PlacedScan up to the end of its `index` field, for `m`'s strings.
+std::uint64_t bytesThroughIndex(const wavog_mapping::PlacedScan& m);
+
 /// The counter of refusal `r` (kNone: nullptr).
 std::uint64_t* refusalCounter(Refusal r, wavog_mapping::VehicleStatus* c);
 

@@ -36,6 +36,8 @@ const char* toString(Refusal r) {
       return "bad_pose";
     case Refusal::kBadSize:
       return "bad_size";
+    case Refusal::kBadLength:
+      return "bad_length";
   }
   return "unknown";
 }

@@ -31,6 +31,9 @@ enum class Refusal {
               ///< ranges not as its version has them (the other array filled, a range_step
               ///< outside [kRangeStep, kMaxRangeStep]), or a period outside
               ///< [0, ScanPeriod::kMaxPeriod] (none a mapper sends)
+  /// An array longer than the message's bytes, or a truncated message: refused before
+  /// deserialisation (checked_subscription.h).
+  kBadLength,
 };
 const char* toString(Refusal r);
 
