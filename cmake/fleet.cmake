@@ -26,7 +26,7 @@ set_target_properties(wavog_fleet PROPERTIES
 
 # wavog_site: the shards' coarse layers put together (issue 36).
 add_executable(wavog_site src/ros/fleet/site_node.cpp src/ros/fleet/site_layers.cpp
-  src/ros/fleet/site_vehicles.cpp)
+  src/ros/fleet/site_params.cpp src/ros/fleet/site_vehicles.cpp)
 target_link_libraries(wavog_site PRIVATE ${catkin_LIBRARIES})
 target_include_directories(wavog_site SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_compile_options(wavog_site PRIVATE ${WAVOG_WARNINGS})
@@ -51,9 +51,9 @@ if(CATKIN_ENABLE_TESTING)
     target_link_libraries(test_range_codec wavog_ros ${GTEST_MAIN_LIBRARIES})
   endif()
   # The site node's parts (issue 36): layers put together, hostile layers refused; the vehicles
-  # outside every region.
+  # outside every region; its parameters.
   catkin_add_gtest(test_site_layers test/ros/test_site_layers.cpp src/ros/fleet/site_layers.cpp
-    src/ros/fleet/site_vehicles.cpp)
+    src/ros/fleet/site_params.cpp src/ros/fleet/site_vehicles.cpp)
   if(TARGET test_site_layers)
     target_include_directories(test_site_layers PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
     target_include_directories(test_site_layers SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})

@@ -6,10 +6,12 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "fleet/site_layers.h"
+#include "fleet/site_params.h"
 #include "fleet/site_vehicles.h"
 
 namespace {
@@ -186,6 +188,101 @@ TEST(SiteVehicles, NamesVehiclesOutsideEveryRegionAndBoundsTheirScans) {
   site = wavog_fleet::summariseVehicles(st, shards);
   EXPECT_EQ(site.scans_mapped_by_none_max, std::numeric_limits<std::uint64_t>::max());
   EXPECT_EQ(site.outside.size(), 2u);
+}
+
+// Issue 42: wavog_site's parameters; each bad value refused naming the parameter and its range.
+XmlRpc::XmlRpcValue siteParams(const std::string& key, const XmlRpc::XmlRpcValue& value) {
+  XmlRpc::XmlRpcValue root;
+  root["shards"][0] = std::string("shard_a");
+  root["shards"][1] = std::string("shard_b");
+  root["scales"][0] = 3;
+  if (!key.empty()) root[key] = value;
+  return root;
+}
+
+std::string refusal(const XmlRpc::XmlRpcValue& root) {
+  try {
+    wavog_fleet::readSiteParams(root);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SiteParams, RefusesEveryBadValueNamingTheParameter) {
+  const wavog_fleet::SiteParams p = wavog_fleet::readSiteParams(siteParams("", {}));
+  EXPECT_EQ(p.shards, (std::vector<std::string>{"shard_a", "shard_b"}));
+  EXPECT_EQ(p.scales, std::vector<int>{3});
+  EXPECT_EQ(p.rate, 1.0);
+  EXPECT_EQ(p.max_cells, kDefaultMaxSiteCells);
+  EXPECT_EQ(wavog_fleet::readSiteParams(siteParams("rate", 2.5)).rate, 2.5);
+  EXPECT_EQ(wavog_fleet::readSiteParams(siteParams("rate", 3)).rate, 3.0);
+  EXPECT_EQ(wavog_fleet::readSiteParams(siteParams("max_cells", 1000)).max_cells, 1000u);
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  // roslaunch hands `rate:=nan` over as the string "nan"; a YAML .nan is a double NaN.
+  for (const XmlRpc::XmlRpcValue& bad :
+       {XmlRpc::XmlRpcValue(std::string("nan")), XmlRpc::XmlRpcValue(std::string("inf")),
+        XmlRpc::XmlRpcValue(nan), XmlRpc::XmlRpcValue(inf), XmlRpc::XmlRpcValue(0.0),
+        XmlRpc::XmlRpcValue(101.0), XmlRpc::XmlRpcValue(true)}) {
+    const std::string why = refusal(siteParams("rate", bad));
+    EXPECT_NE(why.find("~rate must be a number in (0, 100] Hz"), std::string::npos) << why;
+  }
+  for (const XmlRpc::XmlRpcValue& bad :
+       {XmlRpc::XmlRpcValue(std::string("nan")), XmlRpc::XmlRpcValue(nan), XmlRpc::XmlRpcValue(inf),
+        XmlRpc::XmlRpcValue(0), XmlRpc::XmlRpcValue(2.5),
+        XmlRpc::XmlRpcValue(std::ldexp(1.0, 28) + 1.0)}) {
+    const std::string why = refusal(siteParams("max_cells", bad));
+    EXPECT_NE(why.find("~max_cells must be a"), std::string::npos) << why;
+  }
+  // scales:=[3.5] was read as 3.
+  XmlRpc::XmlRpcValue whole = siteParams("", {});
+  whole["scales"][1] = 4.0;
+  EXPECT_EQ(wavog_fleet::readSiteParams(whole).scales, (std::vector<int>{3, 4}));
+  for (const XmlRpc::XmlRpcValue& bad :
+       {XmlRpc::XmlRpcValue(3.5), XmlRpc::XmlRpcValue(0), XmlRpc::XmlRpcValue(13),
+        XmlRpc::XmlRpcValue(std::string("3"))}) {
+    XmlRpc::XmlRpcValue root = siteParams("", {});
+    root["scales"][1] = bad;
+    const std::string why = refusal(root);
+    EXPECT_NE(why.find("~scales must list the scales to assemble (each a whole number in [1, 12]"),
+              std::string::npos)
+        << why;
+  }
+  XmlRpc::XmlRpcValue no_shards = siteParams("", {});
+  no_shards["shards"] = XmlRpc::XmlRpcValue();
+  EXPECT_NE(refusal(no_shards).find("~shards must list"), std::string::npos);
+  XmlRpc::XmlRpcValue bad_shard = siteParams("", {});
+  bad_shard["shards"][1] = std::string("9 bad");
+  EXPECT_NE(refusal(bad_shard).find("~shards entry '9 bad' is not a ROS namespace"),
+            std::string::npos);
+}
+
+TEST(SiteParams, NamesOverlappingRegions) {
+  using wavog_fleet::ShardRegion;
+  const std::vector<ShardRegion> apart = {{"/a", {-64, -64, 38.4, 102.4}},
+                                          {"/b", {38.4, -64, 140.8, 102.4}}};
+  EXPECT_TRUE(wavog_fleet::overlappingRegions(apart).empty());  // they share an edge only
+  const std::vector<ShardRegion> overlap = {{"/a", {-64, -64, 44.8, 102.4}},
+                                            {"/b", {38.4, -64, 140.8, 102.4}},
+                                            {"/c", {200, 0, 300, 100}}};
+  const std::vector<std::string> o = wavog_fleet::overlappingRegions(overlap);
+  ASSERT_EQ(o.size(), 1u);
+  EXPECT_EQ(o[0], "/a [-64, -64, 44.8, 102.4] and /b [38.4, -64, 140.8, 102.4]");
+  const std::vector<ShardRegion> everything = {{"/a", {}}, {"/b", {38.4, -64, 140.8, 102.4}}};
+  ASSERT_EQ(wavog_fleet::overlappingRegions(everything).size(), 1u);
+  // fleet_region values as the parameter server holds them.
+  XmlRpc::XmlRpcValue v;
+  v[0] = 0;
+  v[1] = -6.4;
+  v[2] = 64;
+  v[3] = 6.4;
+  std::vector<double> r;
+  ASSERT_TRUE(wavog_fleet::readRegion(v, &r));
+  EXPECT_EQ(r, (std::vector<double>{0, -6.4, 64, 6.4}));
+  v[3] = std::string("x");
+  EXPECT_FALSE(wavog_fleet::readRegion(v, &r));
 }
 
 }  // namespace
