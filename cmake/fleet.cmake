@@ -51,7 +51,7 @@ if(CATKIN_ENABLE_TESTING)
     target_link_libraries(test_range_codec wavog_ros ${GTEST_MAIN_LIBRARIES})
   endif()
   # The site node's parts (issue 36): layers put together, hostile layers refused; the vehicles
-  # outside every region; its parameters.
+  # outside every region, the scans mapped by none across shard restarts; its parameters.
   catkin_add_gtest(test_site_layers test/ros/test_site_layers.cpp src/ros/fleet/site_layers.cpp
     src/ros/fleet/site_params.cpp src/ros/fleet/site_vehicles.cpp)
   if(TARGET test_site_layers)

@@ -285,7 +285,11 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   }
   EXPECT_EQ(site_diag.get("scans mapped by no shard (at most)"), v4_count);
   EXPECT_EQ(site_diag.get("vehicles outside every region"), "1");
-  EXPECT_EQ(site_diag.get("outside every region"), "/v4");
+  // "/v4", or "/v4 (silent)" once it is stale in both shards (5 s after its last scan).
+  EXPECT_EQ(site_diag.get("outside every region").rfind("/v4", 0), 0u)
+      << site_diag.get("outside every region");
+  EXPECT_EQ(site_diag.get("overlapping regions"), "0");  // the regions share an edge only
+  EXPECT_EQ(site_diag.get("shard restarts"), "0");
   EXPECT_EQ(site_diag.get("layers refused: bad layer"), "0");
   EXPECT_EQ(site_diag.get("layers refused: shards disagree"), "0");
   EXPECT_EQ(site_diag.get("layers refused: over max_cells"), "0");
@@ -393,6 +397,22 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
       gridDiff(*sw, *all_map.get(), wavog::CellBox{384, -1000000, 1000000, 1000000});
   EXPECT_EQ(east_known_cells, 0u) << "shard_a's window holds cells east of its region";
   std::printf("shard_a's window of v1: %zu known cells\n", shard_known);
+
+  // ---- v4 goes silent (stale in both shards): wavog_site keeps it listed (issue 42: it dropped
+  // out of /diagnostics), marked silent, and its count stays.
+  const ros::WallTime silent_until = ros::WallTime::now() + ros::WallDuration(20.0);
+  while (ros::WallTime::now() < silent_until &&
+         site_diag.get("outside every region") != "/v4 (silent)") {
+    ros::WallDuration(0.2).sleep();
+  }
+  for (int i = 1; i <= 2; ++i) {
+    for (const auto& v : status[i].get()->vehicles) {
+      if (v.vehicle == "/v4") EXPECT_TRUE(v.stale) << kNodes[static_cast<std::size_t>(i)];
+    }
+  }
+  EXPECT_EQ(site_diag.get("outside every region"), "/v4 (silent)");
+  EXPECT_EQ(site_diag.get("vehicles outside every region"), "1");
+  EXPECT_EQ(site_diag.get("scans mapped by no shard (at most)"), v4_count);
 
   // ---- a shard restarts and catches up from its own ~save_map (map_file): its map is that map,
   // cell for cell, before any scan reaches it.

@@ -3,6 +3,7 @@
 // or allocating past ~max_cells, and the vehicles outside every region from the shards' statuses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -146,15 +147,27 @@ TEST(SiteLayers, RefusesMalformedLayers) {
   EXPECT_EQ(assemble({&good, &g}, &out), SiteRefusal::kMismatch) << "another resolution";
 }
 
-// Statuses of shards, each listing vehicles.
+// Statuses of shards, each listing vehicles: `outside` of the vehicle's scans (at least 10, all
+// received and integrated) reached no block of the shard's region.
 wavog_mapping::VehicleStatus vehicle(const std::string& name, bool in_region, std::uint64_t outside,
                                      bool stale = false) {
   wavog_mapping::VehicleStatus v;
   v.vehicle = name;
-  v.integrated = 10;
+  v.received = v.integrated = std::max<std::uint64_t>(10, outside);
   v.in_region = in_region;
   v.outside_region = outside;
   v.stale = stale;
+  return v;
+}
+
+// A vehicle's counters in one shard: `received` scans, `mapped` of them reached its region.
+wavog_mapping::VehicleStatus counted(const std::string& name, std::uint64_t received,
+                                     std::uint64_t mapped, bool in_region = false) {
+  wavog_mapping::VehicleStatus v;
+  v.vehicle = name;
+  v.received = v.integrated = received;
+  v.outside_region = received - mapped;
+  v.in_region = in_region;
   return v;
 }
 
@@ -179,7 +192,9 @@ TEST(SiteVehicles, NamesVehiclesOutsideEveryRegionAndBoundsTheirScans) {
   ASSERT_EQ(site.outside.size(), 1u);  // v1 reached /a; v3 stale in /b; v4 unknown to /a
   EXPECT_EQ(site.outside[0].vehicle, "v2");
   EXPECT_EQ(site.outside[0].per_shard, " /a: 40 /b: 38");
-  EXPECT_EQ(site.scans_mapped_by_none_max, 3u + 38u + 7u);  // v1, v2, v3: the smaller count
+  // Per vehicle, the most scans a shard saw less the most a shard mapped: v1 10 - 7, v2 40 - 0
+  // (/b saw 38 of them), v3 10 - 3.
+  EXPECT_EQ(site.scans_mapped_by_none_max, 3u + 40u + 7u);
 
   st[0] = status({vehicle("v1", false, std::numeric_limits<std::uint64_t>::max()),
                   vehicle("v2", false, std::numeric_limits<std::uint64_t>::max())});
@@ -188,6 +203,91 @@ TEST(SiteVehicles, NamesVehiclesOutsideEveryRegionAndBoundsTheirScans) {
   site = wavog_fleet::summariseVehicles(st, shards);
   EXPECT_EQ(site.scans_mapped_by_none_max, std::numeric_limits<std::uint64_t>::max());
   EXPECT_EQ(site.outside.size(), 2u);
+}
+
+// Issue 42: a shard restarts (its counters start again at 0). The scans mapped by none stay an
+// upper bound: the restarted shard's earlier life is kept, and the scans sent while it was down
+// are not mapped by it. Before, the bound was the smallest outside_region of the latest statuses:
+// here 10 (the restarted shard's new count) where 100 scans reached no shard.
+TEST(SiteVehicles, ScansMappedByNoneStayAnUpperBoundAcrossAShardRestart) {
+  const std::vector<std::string> shards = {"/a", "/b"};
+  std::vector<wavog_mapping::FleetStatus::ConstPtr> st(2);
+  wavog_fleet::ShardLives lives(2);
+  auto report = [&](std::size_t i, std::vector<wavog_mapping::VehicleStatus> v) {
+    st[i] = status(std::move(v));
+    lives.add(i, *st[i]);
+  };
+  // v1 outside every region: 50 scans, counted by both shards; v2 in /a's region.
+  report(0, {counted("v1", 50, 0), counted("v2", 50, 50, true)});
+  report(1, {counted("v1", 50, 0), counted("v2", 50, 0)});
+  EXPECT_EQ(wavog_fleet::summariseVehicles(st, shards, lives).scans_mapped_by_none_max, 50u);
+  // /a goes down; 20 more scans of each vehicle, /b alone receives them: v2's 20 are in /a's
+  // region, mapped by none.
+  report(1, {counted("v1", 70, 0), counted("v2", 70, 0)});
+  // /a restarts and receives 10 more of each.
+  report(0, {counted("v1", 10, 0), counted("v2", 10, 10, true)});
+  report(1, {counted("v1", 80, 0), counted("v2", 80, 0)});
+  const wavog_fleet::SiteVehicles site = wavog_fleet::summariseVehicles(st, shards, lives);
+  EXPECT_EQ(lives.restarts(0), 1u);
+  EXPECT_EQ(lives.restarts(1), 0u);
+  EXPECT_EQ(lives.get(0, "v2").mapped, 60u);
+  EXPECT_EQ(lives.get(0, "v2").seen, 60u);
+  // 80 of v1 and 20 of v2 reached no shard; the bound holds them all, exactly here.
+  EXPECT_EQ(site.scans_mapped_by_none_max, 80u + 20u);
+  ASSERT_EQ(site.outside.size(), 1u);
+  EXPECT_EQ(site.outside[0].vehicle, "v1");
+  // A second restart of /a keeps both earlier lives.
+  report(0, {counted("v1", 5, 0), counted("v2", 5, 5, true)});
+  EXPECT_EQ(lives.restarts(0), 2u);
+  EXPECT_EQ(lives.get(0, "v2").mapped, 65u);
+  EXPECT_EQ(wavog_fleet::summariseVehicles(st, shards, lives).scans_mapped_by_none_max,
+            80u + 80u - 65u);
+}
+
+// Scans a shard lost or refused are not mapped by it (a scan in its region it lost is mapped by
+// none).
+TEST(SiteVehicles, ScansAShardLostOrRefusedAreNotMappedByIt) {
+  const std::vector<std::string> shards = {"/a", "/b"};
+  std::vector<wavog_mapping::FleetStatus::ConstPtr> st(2);
+  wavog_mapping::VehicleStatus a = counted("v", 40, 40, true);
+  a.lost = 6;       // 6 scans in /a's region never delivered to /a
+  a.received = 44;  // 4 of them refused
+  a.dropped_bad_pose = 4;
+  st[0] = status({a});
+  st[1] = status({counted("v", 50, 0)});
+  EXPECT_EQ(wavog_fleet::summariseVehicles(st, shards).scans_mapped_by_none_max, 10u);
+}
+
+// Issue 42: a vehicle outside every region stays listed once it goes silent (stale in every
+// shard, its last scan the same in each); before, it dropped out of /diagnostics.
+TEST(SiteVehicles, AVehicleOutsideEveryRegionStaysListedOnceSilent) {
+  const std::vector<std::string> shards = {"/a", "/b"};
+  std::vector<wavog_mapping::FleetStatus::ConstPtr> st(2);
+  wavog_mapping::VehicleStatus a = vehicle("v", false, 20, /*stale=*/true);
+  wavog_mapping::VehicleStatus b = vehicle("v", false, 20, /*stale=*/true);
+  a.last_stamp = b.last_stamp = ros::Time(30.0);
+  st[0] = status({a});
+  st[1] = status({b});
+  wavog_fleet::SiteVehicles site = wavog_fleet::summariseVehicles(st, shards);
+  ASSERT_EQ(site.outside.size(), 1u);
+  EXPECT_EQ(site.outside[0].vehicle, "v");
+  EXPECT_TRUE(site.outside[0].silent);
+  // Its last scan reached /b: not outside.
+  b.in_region = true;
+  st[1] = status({b});
+  EXPECT_TRUE(wavog_fleet::summariseVehicles(st, shards).outside.empty());
+  // The shards' last scans differ (/b has not got the latest one): not known, not named.
+  b.in_region = false;
+  b.last_stamp = ros::Time(29.0);
+  st[1] = status({b});
+  EXPECT_TRUE(wavog_fleet::summariseVehicles(st, shards).outside.empty());
+  // Fresh in every shard: named, not silent.
+  a.stale = b.stale = false;
+  st[0] = status({a});
+  st[1] = status({b});
+  site = wavog_fleet::summariseVehicles(st, shards);
+  ASSERT_EQ(site.outside.size(), 1u);
+  EXPECT_FALSE(site.outside[0].silent);
 }
 
 // Issue 42: wavog_site's parameters; each bad value refused naming the parameter and its range.

@@ -4,8 +4,9 @@
 // so that a dispatcher sees the whole site without the fine grid of all of it. It also follows
 // each shard's <shard>/wavog_fleet/fleet_status (site_vehicles.h) and warns (throttled, per
 // vehicle) about a vehicle whose latest scan reached no shard's region: outside every region, its
-// scans are mapped by no shard. Bad parameters fail at start-up, naming the parameter and its
-// range (site_params.h); shards whose fleet_region parameters overlap are warned about
+// scans are mapped by no shard (also once it is silent); the scans mapped by none stay an upper
+// bound when a shard restarts (ShardLives). Bad parameters fail at start-up, naming the parameter
+// and its range (site_params.h); shards whose fleet_region parameters overlap are warned about
 // once all are known. Layers that cannot be put together are refused (counted by reason, warned
 // with a throttle, not published). Counters and the vehicles outside every region go to
 // /diagnostics.
@@ -108,13 +109,17 @@ int main(int argc, char** argv) {
     }
   }
   // Per shard, the latest ~fleet_status.
-  // Per shard, the latest ~fleet_status.
+  // Per shard, the latest ~fleet_status; every status adds to the shards' lives (restarts).
   std::vector<wavog_mapping::FleetStatus::ConstPtr> statuses(shards.size());
+  wavog_fleet::ShardLives lives(shards.size());
   std::vector<ros::Subscriber> status_subs;
   for (std::size_t i = 0; i < shards.size(); ++i) {
     status_subs.push_back(nh.subscribe<wavog_mapping::FleetStatus>(
         ros::names::append(shards[i], "wavog_fleet/fleet_status"), 2,
-        [&statuses, i](const wavog_mapping::FleetStatus::ConstPtr& m) { statuses[i] = m; }));
+        [&statuses, &lives, i](const wavog_mapping::FleetStatus::ConstPtr& m) {
+          statuses[i] = m;
+          lives.add(i, *m);
+        }));
   }
   // The shards' regions (<shard>/wavog_fleet/fleet_region), read once every shard's is there:
   // overlapping regions warned once, and in /diagnostics.
@@ -133,7 +138,7 @@ int main(int argc, char** argv) {
   ros::WallTime silent_warned;
   ros::WallTimer status_timer =
       nh.createWallTimer(ros::WallDuration(1.0), [&](const ros::WallTimerEvent&) {
-        site = wavog_fleet::summariseVehicles(statuses, shards);
+        site = wavog_fleet::summariseVehicles(statuses, shards, lives);
         if (!regions_read) regions_read = checkRegions(nh, shards, statuses, &overlaps);
         const ros::WallTime now = ros::WallTime::now();
         silent.clear();
@@ -162,9 +167,9 @@ int main(int argc, char** argv) {
           if (it != warned.end() && (now - it->second).toSec() < 5.0) continue;
           warned[v.vehicle] = now;
           ROS_WARN(
-              "wavog_site: vehicle '%s' is outside every region: its latest scan reached no "
+              "wavog_site: vehicle '%s' is outside every region%s: its latest scan reached no "
               "shard, its scans there are mapped by none (outside_region per shard:%s)",
-              v.vehicle.c_str(), v.per_shard.c_str());
+              v.vehicle.c_str(), v.silent ? " (silent since)" : "", v.per_shard.c_str());
         }
       });
 
@@ -227,9 +232,14 @@ int main(int argc, char** argv) {
     s.add("topics without a publisher", silent.size());
     s.add("vehicles outside every region", site.outside.size());
     std::string names;
-    for (const auto& v : site.outside) names += (names.empty() ? "" : " ") + v.vehicle;
+    for (const auto& v : site.outside) {
+      names += (names.empty() ? "" : " ") + v.vehicle + (v.silent ? " (silent)" : "");
+    }
     s.add("outside every region", names);
     s.add("scans mapped by no shard (at most)", site.scans_mapped_by_none_max);
+    std::uint64_t restarts = 0;
+    for (std::size_t i = 0; i < shards.size(); ++i) restarts += lives.restarts(i);
+    s.add("shard restarts", restarts);
     s.add("overlapping regions", overlaps.size());
   });
   ros::WallTimer diag_timer = nh.createWallTimer(
