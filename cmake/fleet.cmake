@@ -60,6 +60,12 @@ if(CATKIN_ENABLE_TESTING)
     target_link_libraries(test_site_layers ${catkin_LIBRARIES} ${GTEST_MAIN_LIBRARIES})
     add_dependencies(test_site_layers ${PROJECT_NAME}_generate_messages_cpp)
   endif()
+  # A vehicle's window of the fleet map: the same cells wherever its centre falls (issue 42).
+  catkin_add_gtest(test_vehicle_windows test/ros/test_vehicle_windows.cpp)
+  if(TARGET test_vehicle_windows)
+    target_include_directories(test_vehicle_windows PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
+    target_link_libraries(test_vehicle_windows wavog_ros ${GTEST_MAIN_LIBRARIES})
+  endif()
   # A vehicle's intake (issue 37): counters, refusals, the index sequence.
   catkin_add_gtest(test_fleet_intake test/ros/test_fleet_intake.cpp)
   if(TARGET test_fleet_intake)

@@ -363,9 +363,10 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   const auto [window_differ, window_known] = gridDiff(*win, *all_map.get());
   EXPECT_EQ(window_differ, 0u) << "of " << win->data.size();
   EXPECT_GT(window_known, 1000u);
-  // 8 m each side of v1's latest position at 10 cm.
-  EXPECT_NEAR(win->info.width, 160, 2);
-  EXPECT_NEAR(win->info.height, 160, 2);
+  // 8 m each side of v1's cell at 10 cm: 2 x 80 + 1 cells wherever v1 is in its cell (issue 42:
+  // 160 to 162 before).
+  EXPECT_EQ(win->info.width, 161u);
+  EXPECT_EQ(win->info.height, 161u);
   const auto site = site_scale.get();
   const auto scale = all_scale.get();
   const auto [site_differ, site_known] = gridDiff(*site, *scale);
