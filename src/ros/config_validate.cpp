@@ -114,10 +114,12 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
     } else {
       fleetRegionBlocks(ros.fleet_region, map.grid, &r, &why);
     }
+    const double extent = std::ldexp(map.grid.resolution, 30);
     check(why.empty(), &e,
           "fleet_region must be [] (everything) or [min_x, min_y, max_x, max_y] in m, min < max, "
           "each a multiple of the block size (resolution x 2^block_levels = " +
-              fmt(map.grid.resolution * std::ldexp(1.0, map.grid.block_levels)) + " m): " + why);
+              fmt(map.grid.resolution * std::ldexp(1.0, map.grid.block_levels)) +
+              " m) within the map's extent (+-" + fmt(extent) + " m): " + why);
   }
   return e;
 }
@@ -135,6 +137,14 @@ bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParam
     const double rounded = std::round(k);
     if (std::abs(k - rounded) > 1e-6) {
       *why = "value " + fmt(region[i]) + " is not a multiple of " + fmt(block) + " m";
+      return false;
+    }
+    // The core's extent: finest cell indices within +-2^30 (MapParams::validate checks the
+    // blocks again, under its own name).
+    const double limit = std::ldexp(1.0, 30 - grid.block_levels);
+    if (std::abs(rounded) > limit) {
+      *why = "value " + fmt(region[i]) + " is beyond the map's extent (+-" +
+             fmt(std::ldexp(grid.resolution, 30)) + " m: 2^30 cells of resolution)";
       return false;
     }
     b[i] = static_cast<std::int64_t>(rounded);

@@ -176,9 +176,20 @@ TEST(Config, FleetRegionIsTheCoresBlockRegionOrAClearError) {
             std::string::npos);
   EXPECT_NE(errorOf("{fleet_region: [0, 0, .nan, 1]}").find("fleet_region"), std::string::npos);
   EXPECT_NE(errorOf("{fleet_region: 3}").find("'fleet_region'"), std::string::npos);
-  // Beyond the extent: the core's rule names it.
-  EXPECT_NE(errorOf("{resolution: 1, block_levels: 2, fleet_region: [0, 0, 4e9, 4]}").find("region"),
-            std::string::npos);
+  // Beyond the extent (issue 42): fleet_region names it and the extent, not the core's
+  // "region (blocks ...)".
+  for (const std::string yaml : {"{resolution: 1, block_levels: 2, fleet_region: [0, 0, 4e9, 4]}",
+                                 "{block_levels: 7, fleet_region: [0, 0, 1.0e+12, 6.4]}",
+                                 "{block_levels: 7, fleet_region: [-53687097.6, 0, 6.4, 6.4]}"}) {
+    const std::string why = errorOf(yaml);
+    EXPECT_NE(why.find(form), std::string::npos) << why;
+    EXPECT_NE(why.find("beyond the map's extent"), std::string::npos) << why;
+    EXPECT_EQ(why.find("region (blocks"), std::string::npos) << why;
+  }
+  // The extent itself: 2^30 cells of 5 cm, 53,687,091.2 m.
+  const std::string edge = "{block_levels: 7, fleet_region: [-53687091.2, 0, 6.4, 6.4]}";
+  EXPECT_EQ(errorOf(edge), "");
+  EXPECT_FALSE(fromYaml(edge).map.region.all);
 }
 
 TEST(Config, FleetWindowIsBoundedByTheLayerLimit) {

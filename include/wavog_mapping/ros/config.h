@@ -149,7 +149,8 @@ const char* toString(wavog::Aggregation aggregation);
 bool fromString(const std::string& name, wavog::Aggregation* aggregation);
 
 /// fleet_region (m) as the blocks of a map of `grid` (`region` must hold 4 values): false, with
-/// *why, when they are not finite, min < max and multiples of the block size.
+/// *why, when they are not finite, min < max, multiples of the block size and within the map's
+/// extent (finest cell indices within +-2^30, as MapParams::region).
 bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParams& grid,
                        wavog::BlockRegion* out, std::string* why);
 
