@@ -100,13 +100,19 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
             ros.fleet_max_stamp_offset <= 86400.0,
         &e, "fleet_max_stamp_offset (" + fmt(ros.fleet_max_stamp_offset) +
                 ") must be in (0, 86400] s");
-  // A window of half-width w holds (2 w / resolution + 2)^2 cells at most (kMaxLayerCells).
+  // A window of half-width w holds (2 w / resolution + 2)^2 cells at most (kMaxLayerCells). With
+  // a bad resolution or block_levels (named by the map's own rules) the limits that depend on
+  // them are not checked: they would add bogus errors.
+  const bool grid_ok = std::isfinite(map.grid.resolution) && map.grid.resolution > 0.0 &&
+                       map.grid.block_levels >= 2 && map.grid.block_levels <= 12;
   const double max_window = 0.5 * (4096.0 - 2.0) * map.grid.resolution;  // 4096^2 = 2^24 cells
   check(std::isfinite(ros.fleet_window) && ros.fleet_window >= 0.0 &&
-            ros.fleet_window <= max_window,
-        &e, "fleet_window (" + fmt(ros.fleet_window) + ") must be in [0, " + fmt(max_window) +
-                "] m (0: off; the window must hold at most 2^24 cells)");
-  if (!ros.fleet_region.empty()) {
+            (!grid_ok || ros.fleet_window <= max_window),
+        &e,
+        "fleet_window (" + fmt(ros.fleet_window) + ") must be in [0, " +
+            (grid_ok ? fmt(max_window) : "2047 x resolution") +
+            "] m (0: off; the window must hold at most 2^24 cells)");
+  if (!ros.fleet_region.empty() && grid_ok) {
     std::string why;
     wavog::BlockRegion r;
     if (ros.fleet_region.size() != 4) {

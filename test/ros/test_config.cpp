@@ -249,6 +249,33 @@ TEST(Config, BadValuesNameTheParameterAndItsRange) {
   EXPECT_NE(errorOf("inputs: [{topic: a, rate: 3}]").find("unknown key 'rate'"), std::string::npos);
 }
 
+// Issue 41, item 8: a bad resolution is one error (the limits that depend on it are not checked
+// with it); a number YAML 1.1 reads as a string says so.
+TEST(Config, ABadResolutionIsOneErrorAndYaml11NumbersGetAHint) {
+  for (const std::string yaml :
+       {"resolution: -1", "resolution: 0", "resolution: .nan",
+        "{resolution: -1, fleet_window: 4, fleet_region: [0, 0, 6.4, 6.4]}"}) {
+    const std::string why = errorOf(yaml);
+    std::size_t lines = 0;
+    for (std::size_t at = why.find("\n  "); at != std::string::npos;
+         at = why.find("\n  ", at + 1)) {
+      ++lines;
+    }
+    EXPECT_EQ(lines, 1u) << yaml << ": " << why;
+    EXPECT_NE(why.find("resolution"), std::string::npos) << why;
+    EXPECT_EQ(why.find("fleet_window"), std::string::npos) << why;
+  }
+  // rosparam's YAML 1.1 hands 5e-2 over as the string "5e-2".
+  const std::string why = errorOf("resolution: '5e-2'");
+  EXPECT_NE(why.find("parameter 'resolution' ('5e-2') must be a number: YAML 1.1"),
+            std::string::npos)
+      << why;
+  EXPECT_NE(why.find("write 0.05 or 5.0e-2"), std::string::npos) << why;
+  EXPECT_NE(errorOf("gamma: '1e-1'").find("write 0.1 or 1.0e-1"), std::string::npos);
+  EXPECT_NE(errorOf("gamma: '2.5e3'").find("write 2500 or 2.5e+3"), std::string::npos);
+  EXPECT_EQ(errorOf("gamma: abc").find("YAML 1.1"), std::string::npos);
+}
+
 TEST(Config, MissingOrMalformedFileIsAClearError) {
   try {
     loadConfigFile("/nonexistent/x.yaml", nullptr);
