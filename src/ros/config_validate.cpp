@@ -130,6 +130,23 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
   return e;
 }
 
+std::string duplicateInputs(const std::vector<InputConfig>& inputs,
+                            const std::function<std::string(const std::string&)>& resolve) {
+  std::vector<std::string> resolved;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    resolved.push_back(resolve(inputs[i].topic));
+    for (std::size_t j = 0; j < i; ++j) {
+      if (resolved[j] != resolved[i]) continue;
+      return "inputs[" + std::to_string(j) + "].topic ('" + inputs[j].topic + "') and inputs[" +
+             std::to_string(i) + "].topic ('" + inputs[i].topic + "') are one topic, " +
+             resolved[i] +
+             ", in this namespace: every scan would be integrated twice; list each topic once in "
+             "inputs";
+    }
+  }
+  return "";
+}
+
 bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParams& grid,
                        wavog::BlockRegion* out, std::string* why) {
   const double block = grid.resolution * std::ldexp(1.0, grid.block_levels);

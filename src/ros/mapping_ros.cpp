@@ -47,6 +47,11 @@ void MappingRos::Impl::warnDroppedPayloads(const std::string& path) const {
 MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, MapperRole role)
     : nh_(nh), pnh_(pnh), config_(loadReportingUnknown(pnh)), map_(config_.map) {
   const RosParams& rp = config_.ros;
+  if (role == MapperRole::kMapper) {  // in this namespace, with the node's remappings
+    const std::string duplicate = duplicateInputs(
+        rp.inputs, [this](const std::string& topic) { return nh_.resolveName(topic); });
+    if (!duplicate.empty()) throw std::invalid_argument("invalid configuration: " + duplicate);
+  }
   placement_.fixed_frame = rp.map_frame;
   placement_.motion_compensation = rp.motion_compensation;
   if (!rp.map_file.empty()) {

@@ -2,6 +2,7 @@
 // defaults key by key, unknown keys are reported, bad values name the parameter and its range.
 #include <dirent.h>
 #include <gtest/gtest.h>
+#include <ros/names.h>
 
 #include <algorithm>
 #include <fstream>
@@ -274,6 +275,22 @@ TEST(Config, ABadResolutionIsOneErrorAndYaml11NumbersGetAHint) {
   EXPECT_NE(errorOf("gamma: '1e-1'").find("write 0.1 or 1.0e-1"), std::string::npos);
   EXPECT_NE(errorOf("gamma: '2.5e3'").find("write 2500 or 2.5e+3"), std::string::npos);
   EXPECT_EQ(errorOf("gamma: abc").find("YAML 1.1"), std::string::npos);
+}
+
+// Issue 41, item 6: two inputs that are one topic once resolved are refused naming inputs.
+TEST(Config, InputsThatResolveToOneTopicAreRefused) {
+  const auto in_ns = [](const std::string& ns) {
+    return [ns](const std::string& t) { return ros::names::resolve(ns, t, false); };
+  };
+  const Config c = fromYaml("inputs: [{topic: scan}, {topic: /scan}]");  // valid as written
+  const std::string why = duplicateInputs(c.ros.inputs, in_ns("/"));
+  EXPECT_EQ(why,
+            "inputs[0].topic ('scan') and inputs[1].topic ('/scan') are one topic, /scan, in "
+            "this namespace: every scan would be integrated twice; list each topic once in "
+            "inputs");
+  EXPECT_EQ(duplicateInputs(c.ros.inputs, in_ns("/robot")), "");  // /robot/scan and /scan
+  EXPECT_NE(duplicateInputs(fromYaml("inputs: [a, b, /robot/a]").ros.inputs, in_ns("/robot")), "");
+  EXPECT_EQ(duplicateInputs(fromYaml("inputs: [a, b, c, d]").ros.inputs, in_ns("/")), "");
 }
 
 TEST(Config, MissingOrMalformedFileIsAClearError) {

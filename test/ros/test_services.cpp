@@ -425,6 +425,24 @@ TEST_F(Services, BadParameterFailsAtStartUpNamingIt) {
   EXPECT_NE(output.find("publish_rate (-2) must be in (0, 100] Hz"), std::string::npos) << output;
 }
 
+// Issue 41, item 6: `scan` and `/scan` in the root namespace are one topic: refused at start-up
+// naming inputs (every scan was integrated twice).
+TEST_F(Services, InputsThatAreOneTopicAreRefusedAtStartUp) {
+  XmlRpc::XmlRpcValue inputs;
+  inputs[0] = std::string("scan");
+  inputs[1] = std::string("/scan");
+  ros::param::set("/dup_inputs/inputs", inputs);
+  std::string output;
+  const int code = room::run(
+      std::string("timeout 8 ") + WAVOG_NODE_BIN + " __name:=dup_inputs map:=/dup_inputs/map",
+      &output);
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find("inputs[0].topic ('scan') and inputs[1].topic ('/scan') are one topic, "
+                        "/scan"),
+            std::string::npos)
+      << output;
+}
+
 TEST_F(Services, NodeletWithBadParameterFailsToLoadNamingIt) {
   std::string output;
   const int code = room::run("timeout 8 " + std::string(WAVOG_NODELET_BIN) +

@@ -8,6 +8,7 @@
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -156,6 +157,12 @@ bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParam
 
 /// Every violation of the ROS parameters (given the core parameters), one line each.
 std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& map);
+
+/// Two inputs naming one topic once resolved by `resolve` (the node handle's resolveName: its
+/// namespace and remappings; `scan` and `/scan` in the root namespace): the error naming
+/// `inputs`, empty when every input is a topic of its own.
+std::string duplicateInputs(const std::vector<InputConfig>& inputs,
+                            const std::function<std::string(const std::string&)>& resolve);
 
 }  // namespace wavog_ros
 
