@@ -138,6 +138,20 @@ TEST_F(Services, SaveMapWritesNativeAndMapServerFiles) {
     EXPECT_GE(h, 30);
   }
 
+  // The answer says where the files went (issue 41: a relative path goes below map_dir, /tmp
+  // here, not the caller's working directory).
+  EXPECT_EQ(srv.response.message.rfind("saved 9 files in " + kDir + ": room.wavog room_s0.pgm", 0),
+            0u)
+      << srv.response.message;
+  wavog_mapping::SaveMap relative;
+  relative.request.path = kDir.substr(5) + "/rel/room.wavog";  // below map_dir: /tmp
+  ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", relative));
+  EXPECT_TRUE(relative.response.success) << relative.response.message;
+  ASSERT_FALSE(relative.response.files.empty());
+  EXPECT_EQ(relative.response.files[0], kDir + "/rel/room.wavog");
+  EXPECT_NE(relative.response.message.find(" in " + kDir + "/rel: room.wavog"), std::string::npos)
+      << relative.response.message;
+
   // A missing folder is created.
   wavog_mapping::SaveMap nested;
   nested.request.path = kDir + "/new/sub/room.wavog";
