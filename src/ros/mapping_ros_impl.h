@@ -29,6 +29,7 @@
 #include "map_publisher.h"
 #include "wavog_mapping/ros/pose_check.h"
 #include "reconfigure.h"
+#include "tf_messages.h"
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"
 #include "wavog_mapping/MappingConfig.h"
