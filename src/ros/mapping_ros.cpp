@@ -98,6 +98,7 @@ MappingRos::Impl::~Impl() {
   update_timer_.stop();
   diag_timer_.stop();
   idle_timer_.stop();
+  silent_timer_.stop();
   tf_sub_.shutdown();
   tf_static_sub_.shutdown();
   for (auto& in : inputs_) in->sub.shutdown();
@@ -207,6 +208,13 @@ void MappingRos::Impl::startTimers() {
   diag_timer_ = nh_.createTimer(ros::Duration(kDiagnosticsPeriod), [this](const ros::TimerEvent&) {
     guarded("diagnostics timer", nullptr, [&] { updater_->update(); });
   });
+  if (!inputs_.empty()) {
+    // Wall time: a bag on other topics may be what drives /clock, or nothing does.
+    silent_timer_ = nh_.createWallTimer(
+        ros::WallDuration(kSilentInputPeriod), [this](const ros::WallTimerEvent&) {
+          guarded("silent input timer", nullptr, [&] { warnSilentInputs(); });
+        });
+  }
   if (rp.idle_timeout > 0.0) {
     // Wall time: with use_sim_time the clock stops with the bag, and ROS timers with it.
     noteActivity();

@@ -457,6 +457,19 @@ TEST_F(Services, InputsThatAreOneTopicAreRefusedAtStartUp) {
       << output;
 }
 
+// Issue 41, item 2: an input nothing publishes is warned on the console with the LaserScan
+// topics that exist (this test advertises /scan_1); /diagnostics alone said "no scan yet".
+TEST_F(Services, AnInputWithoutPublisherNamesTheLaserScanTopics) {
+  std::string output;
+  room::run(std::string("timeout 14 ") + WAVOG_NODE_BIN + " __ns:=/silent __name:=wavog_mapping",
+            &output);
+  EXPECT_NE(output.find("no scan received on /silent/scan: nothing publishes it. LaserScan "
+                        "topics advertised: "),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("/scan_1"), std::string::npos) << output;
+}
+
 TEST_F(Services, NodeletWithBadParameterFailsToLoadNamingIt) {
   std::string output;
   const int code = room::run("timeout 8 " + std::string(WAVOG_NODELET_BIN) +
