@@ -105,6 +105,14 @@ for launch in mapping.launch mapping_node.launch playback.launch; do
 done
 echo "install_test: map_frame: the config's value holds unless given as an argument"
 
+# The nodelet and the node start with the same configuration by default (issue 41).
+nodelet_params=$(ros_env "roslaunch --dump-params wavog_mapping mapping.launch" | sort)
+node_params=$(ros_env "roslaunch --dump-params wavog_mapping mapping_node.launch" | sort)
+[ "$nodelet_params" = "$node_params" ] ||
+  { diff <(echo "$nodelet_params") <(echo "$node_params") || true
+    fail "mapping.launch and mapping_node.launch default to different configurations"; }
+echo "install_test: mapping.launch and mapping_node.launch: the same default configuration"
+
 # rviz:=true: rviz's fixed frame is the map frame, the config's or map_frame:= (issue 41), as the
 # launch starts it (its command line, run with a stand-in rviz that prints its arguments).
 mkdir -p "$work/fake_rviz"
@@ -150,7 +158,7 @@ run_case() {
   grep -h 'wait_for_map' "$log.wait"
   echo "install_test: $name: ok"
 }
-run_case mapping "mapping.launch use_sim_time:=true" ""
+run_case mapping "mapping.launch use_sim_time:=true" "scan_front_left:=scan"
 run_case mapping_node "mapping_node.launch use_sim_time:=true" "scan_front_left:=scan"
 # No tf in the bag at all: the laser held fixed to the map frame by wavog_static_tf.
 run_case fixed_frame_laser \
