@@ -82,7 +82,7 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node
     COMMAND $<TARGET_FILE:wavog_simulate> --vehicles 3 --duration 28 --seed 5 --out ${WAVOG_FLEET_BAG}
     DEPENDS wavog_simulate
     COMMENT "wavog_simulate: the fleet rostest's bag (3 vehicles, 28 s)")
-  add_custom_target(wavog_fleet_test_bag ALL DEPENDS ${WAVOG_FLEET_BAG})
+  add_custom_target(wavog_fleet_test_bag DEPENDS ${WAVOG_FLEET_BAG})  # built with the test
   add_rostest_gtest(test_fleet_system test/fleet.test test/ros/test_fleet_system.cpp)
   target_link_libraries(test_fleet_system wavog_ros wavog_ros_config wavog_sim wavog_core
                         ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
