@@ -23,14 +23,16 @@ $(BUILD)/CMakeCache.txt: | deps
 	@cmake -S $(ROOT) -B $(BUILD) -DCATKIN_DEVEL_PREFIX=$(BUILD)/devel $(CMAKE_ARGS) >$(BUILD)/configure.log \
 	  || { cat $(BUILD)/configure.log; exit 1; }
 
+# What a user runs (the `all` target: node, nodelet, tools; no test: cmake/test_targets.cmake).
 # A build that left real-data tests out configures again, in case the data has come since.
 build: deps $(BUILD)/CMakeCache.txt
 	@if [ -s $(BUILD)/real_data_missing.txt ]; then cmake $(BUILD) >$(BUILD)/configure.log \
 	  || { cat $(BUILD)/configure.log; exit 1; }; fi
-	@bash $(ROOT)/scripts/build.sh $(BUILD) $(JOBS)
+	@bash $(ROOT)/scripts/build.sh $(BUILD) $(JOBS) all
 
-## Every test (core gtests and rostests); ends with "N passed, N failed".
+## Every test (core gtests and rostests), built here; ends with "N passed, N failed".
 test: build
+	@bash $(ROOT)/scripts/build.sh $(BUILD) $(JOBS)
 	@bash $(ROOT)/scripts/run_tests.sh $(BUILD)
 
 ## The core tests under AddressSanitizer + UndefinedBehaviorSanitizer, in the clang tree of

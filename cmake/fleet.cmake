@@ -26,7 +26,7 @@ set_target_properties(wavog_fleet PROPERTIES
 
 # wavog_site: the shards' coarse layers put together (issue 36).
 add_executable(wavog_site src/ros/fleet/site_node.cpp src/ros/fleet/site_layers.cpp
-  src/ros/fleet/site_vehicles.cpp)
+  src/ros/fleet/site_params.cpp src/ros/fleet/site_vehicles.cpp)
 target_link_libraries(wavog_site PRIVATE ${catkin_LIBRARIES})
 target_include_directories(wavog_site SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_compile_options(wavog_site PRIVATE ${WAVOG_WARNINGS})
@@ -51,14 +51,20 @@ if(CATKIN_ENABLE_TESTING)
     target_link_libraries(test_range_codec wavog_ros ${GTEST_MAIN_LIBRARIES})
   endif()
   # The site node's parts (issue 36): layers put together, hostile layers refused; the vehicles
-  # outside every region.
+  # outside every region, the scans mapped by none across shard restarts; its parameters.
   catkin_add_gtest(test_site_layers test/ros/test_site_layers.cpp src/ros/fleet/site_layers.cpp
-    src/ros/fleet/site_vehicles.cpp)
+    src/ros/fleet/site_params.cpp src/ros/fleet/site_vehicles.cpp)
   if(TARGET test_site_layers)
     target_include_directories(test_site_layers PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
     target_include_directories(test_site_layers SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
     target_link_libraries(test_site_layers ${catkin_LIBRARIES} ${GTEST_MAIN_LIBRARIES})
     add_dependencies(test_site_layers ${PROJECT_NAME}_generate_messages_cpp)
+  endif()
+  # A vehicle's window of the fleet map: the same cells wherever its centre falls (issue 42).
+  catkin_add_gtest(test_vehicle_windows test/ros/test_vehicle_windows.cpp)
+  if(TARGET test_vehicle_windows)
+    target_include_directories(test_vehicle_windows PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
+    target_link_libraries(test_vehicle_windows wavog_ros ${GTEST_MAIN_LIBRARIES})
   endif()
   # A vehicle's intake (issue 37): counters, refusals, the index sequence.
   catkin_add_gtest(test_fleet_intake test/ros/test_fleet_intake.cpp)
@@ -76,7 +82,7 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node
     COMMAND $<TARGET_FILE:wavog_simulate> --vehicles 3 --duration 28 --seed 5 --out ${WAVOG_FLEET_BAG}
     DEPENDS wavog_simulate
     COMMENT "wavog_simulate: the fleet rostest's bag (3 vehicles, 28 s)")
-  add_custom_target(wavog_fleet_test_bag ALL DEPENDS ${WAVOG_FLEET_BAG})
+  add_custom_target(wavog_fleet_test_bag DEPENDS ${WAVOG_FLEET_BAG})  # built with the test
   add_rostest_gtest(test_fleet_system test/fleet.test test/ros/test_fleet_system.cpp)
   target_link_libraries(test_fleet_system wavog_ros wavog_ros_config wavog_sim wavog_core
                         ${catkin_LIBRARIES} ${GTEST_LIBRARIES})

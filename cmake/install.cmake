@@ -26,6 +26,8 @@ if(WAVOG_BUILD_ROS)
   catkin_install_python(PROGRAMS scripts/plot_evaluation.py scripts/plot_compare.py
                         scripts/paper_figures.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
   install(FILES scripts/figure_common.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+  # rviz with the mapper's map frame as its fixed frame (the launch files' rviz:=true).
+  install(PROGRAMS scripts/wavog_rviz DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
   # Libraries: the nodelet plugins, what the programs link, and what catkin_package() exports.
   set(_wavog_libraries wavog_core wavog_io wavog_ros_config wavog_ros wavog_mapping_nodelet

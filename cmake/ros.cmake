@@ -21,6 +21,7 @@ if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/mapping_ros.cpp)
   add_library(wavog_ros
     src/ros/conversions.cpp
     src/ros/scan_placement.cpp
+    src/ros/tf_messages.cpp
     src/ros/input_status.cpp
     src/ros/pose_check.cpp
     src/ros/map_publisher.cpp
@@ -59,6 +60,8 @@ if(CATKIN_ENABLE_TESTING)
     catkin_add_gtest(test_scan_placement test/ros/test_scan_placement.cpp)
     if(TARGET test_scan_placement)
       target_link_libraries(test_scan_placement wavog_ros ${GTEST_MAIN_LIBRARIES})
+      # tf_messages.h (the node's tf failure texts), a private header of src/ros.
+      target_include_directories(test_scan_placement PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
     endif()
     # The file names and crop shared by ~save_map and wavog_offline (wavog_io).
     catkin_add_gtest(test_map_files test/ros/test_map_files.cpp)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds in a configured build tree: scripts/build.sh BUILD_DIR JOBS [TARGET...].
-# Without targets: everything, with catkin's test executables (they hang off its `tests` target,
-# outside `all`). A failed build is run once more before it counts as failed: GCC 12 has crashed
+# Without targets: everything, with the test executables (they hang off the `tests` target,
+# outside `all`: cmake/test_targets.cmake). `make build` passes `all`, `make test` nothing. A failed build is run once more before it counts as failed: GCC 12 has crashed
 # on this project's VMs now and then (an internal compiler error in a file that built before and
 # after, unchanged); a real error fails the second time too.
 set -uo pipefail

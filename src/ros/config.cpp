@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <set>
@@ -27,6 +28,16 @@ std::string describe(XmlRpcValue& v) {
   throw std::invalid_argument("parameter '" + key + "' (" + describe(v) + ") must be " + expected);
 }
 
+// A string that reads as a number: rosparam's YAML 1.1 takes 5e-2 (no '.' in the mantissa, or no
+// sign in the exponent) for a string.
+bool numberInAString(XmlRpcValue& v) {
+  if (v.getType() != XmlRpcValue::TypeString) return false;
+  const std::string text = static_cast<std::string>(v);
+  char* end = nullptr;
+  std::strtod(text.c_str(), &end);
+  return !text.empty() && end == text.c_str() + text.size();
+}
+
 double asDouble(const std::string& key, XmlRpcValue& v) {
   switch (v.getType()) {
     case XmlRpcValue::TypeDouble:
@@ -34,6 +45,25 @@ double asDouble(const std::string& key, XmlRpcValue& v) {
     case XmlRpcValue::TypeInt:
       return static_cast<double>(static_cast<int>(v));
     default:
+      if (numberInAString(v)) {
+        const std::string text = static_cast<std::string>(v);
+        std::ostringstream plain;
+        plain << std::strtod(text.c_str(), nullptr);
+        // The same in YAML 1.1's float form: a '.' in the mantissa, a signed exponent.
+        std::string yaml11 = text;
+        const std::size_t e = yaml11.find_first_of("eE");
+        if (e != std::string::npos) {
+          if (yaml11.find('.') == std::string::npos) yaml11.insert(e, ".0");
+          const std::size_t sign = yaml11.find_first_of("eE") + 1;
+          if (sign < yaml11.size() && yaml11[sign] != '-' && yaml11[sign] != '+') {
+            yaml11.insert(sign, "+");
+          }
+        }
+        throw std::invalid_argument("parameter '" + key + "' ('" + text +
+                                    "') must be a number: YAML 1.1 (rosparam, roslaunch) reads " +
+                                    text + " as a string; write " + plain.str() +
+                                    (yaml11 != text ? " or " + yaml11 : std::string()));
+      }
       typeError(key, v, "a number");
   }
 }

@@ -106,13 +106,19 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
             ros.fleet_max_stamp_offset <= 86400.0,
         &e, "fleet_max_stamp_offset (" + fmt(ros.fleet_max_stamp_offset) +
                 ") must be in (0, 86400] s");
-  // A window of half-width w holds (2 w / resolution + 2)^2 cells at most (kMaxLayerCells).
+  // A window of half-width w holds (2 w / resolution + 2)^2 cells at most (kMaxLayerCells). With
+  // a bad resolution or block_levels (named by the map's own rules) the limits that depend on
+  // them are not checked: they would add bogus errors.
+  const bool grid_ok = std::isfinite(map.grid.resolution) && map.grid.resolution > 0.0 &&
+                       map.grid.block_levels >= 2 && map.grid.block_levels <= 12;
   const double max_window = 0.5 * (4096.0 - 2.0) * map.grid.resolution;  // 4096^2 = 2^24 cells
   check(std::isfinite(ros.fleet_window) && ros.fleet_window >= 0.0 &&
-            ros.fleet_window <= max_window,
-        &e, "fleet_window (" + fmt(ros.fleet_window) + ") must be in [0, " + fmt(max_window) +
-                "] m (0: off; the window must hold at most 2^24 cells)");
-  if (!ros.fleet_region.empty()) {
+            (!grid_ok || ros.fleet_window <= max_window),
+        &e,
+        "fleet_window (" + fmt(ros.fleet_window) + ") must be in [0, " +
+            (grid_ok ? fmt(max_window) : "2047 x resolution") +
+            "] m (0: off; the window must hold at most 2^24 cells)");
+  if (!ros.fleet_region.empty() && grid_ok) {
     std::string why;
     wavog::BlockRegion r;
     if (ros.fleet_region.size() != 4) {
@@ -120,12 +126,31 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
     } else {
       fleetRegionBlocks(ros.fleet_region, map.grid, &r, &why);
     }
+    const double extent = std::ldexp(map.grid.resolution, 30);
     check(why.empty(), &e,
           "fleet_region must be [] (everything) or [min_x, min_y, max_x, max_y] in m, min < max, "
           "each a multiple of the block size (resolution x 2^block_levels = " +
-              fmt(map.grid.resolution * std::ldexp(1.0, map.grid.block_levels)) + " m): " + why);
+              fmt(map.grid.resolution * std::ldexp(1.0, map.grid.block_levels)) +
+              " m) within the map's extent (+-" + fmt(extent) + " m): " + why);
   }
   return e;
+}
+
+std::string duplicateInputs(const std::vector<InputConfig>& inputs,
+                            const std::function<std::string(const std::string&)>& resolve) {
+  std::vector<std::string> resolved;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    resolved.push_back(resolve(inputs[i].topic));
+    for (std::size_t j = 0; j < i; ++j) {
+      if (resolved[j] != resolved[i]) continue;
+      return "inputs[" + std::to_string(j) + "].topic ('" + inputs[j].topic + "') and inputs[" +
+             std::to_string(i) + "].topic ('" + inputs[i].topic + "') are one topic, " +
+             resolved[i] +
+             ", in this namespace: every scan would be integrated twice; list each topic once in "
+             "inputs";
+    }
+  }
+  return "";
 }
 
 bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParams& grid,
@@ -141,6 +166,14 @@ bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParam
     const double rounded = std::round(k);
     if (std::abs(k - rounded) > 1e-6) {
       *why = "value " + fmt(region[i]) + " is not a multiple of " + fmt(block) + " m";
+      return false;
+    }
+    // The core's extent: finest cell indices within +-2^30 (MapParams::validate checks the
+    // blocks again, under its own name).
+    const double limit = std::ldexp(1.0, 30 - grid.block_levels);
+    if (std::abs(rounded) > limit) {
+      *why = "value " + fmt(region[i]) + " is beyond the map's extent (+-" +
+             fmt(std::ldexp(grid.resolution, 30)) + " m: 2^30 cells of resolution)";
       return false;
     }
     b[i] = static_cast<std::int64_t>(rounded);

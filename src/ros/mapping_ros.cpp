@@ -49,6 +49,11 @@ void MappingRos::Impl::warnDroppedPayloads(const std::string& path) const {
 MappingRos::Impl::Impl(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, MapperRole role)
     : nh_(nh), pnh_(pnh), config_(loadReportingUnknown(pnh)), map_(config_.map) {
   const RosParams& rp = config_.ros;
+  if (role == MapperRole::kMapper) {  // in this namespace, with the node's remappings
+    const std::string duplicate = duplicateInputs(
+        rp.inputs, [this](const std::string& topic) { return nh_.resolveName(topic); });
+    if (!duplicate.empty()) throw std::invalid_argument("invalid configuration: " + duplicate);
+  }
   placement_.fixed_frame = rp.map_frame;
   placement_.motion_compensation = rp.motion_compensation;
   if (!rp.map_file.empty()) {
@@ -95,6 +100,7 @@ MappingRos::Impl::~Impl() {
   update_timer_.stop();
   diag_timer_.stop();
   idle_timer_.stop();
+  silent_timer_.stop();
   tf_sub_.shutdown();
   tf_static_sub_.shutdown();
   for (auto& in : inputs_) in->sub.shutdown();
@@ -211,6 +217,13 @@ void MappingRos::Impl::startTimers() {
       ros::WallDuration(kDiagnosticsPeriod), [this](const ros::WallTimerEvent&) {
         guarded("diagnostics timer", nullptr, [&] { updater_->force_update(); });
       });
+  if (!inputs_.empty()) {
+    // Wall time: a bag on other topics may be what drives /clock, or nothing does.
+    silent_timer_ = nh_.createWallTimer(
+        ros::WallDuration(kSilentInputPeriod), [this](const ros::WallTimerEvent&) {
+          guarded("silent input timer", nullptr, [&] { warnSilentInputs(); });
+        });
+  }
   if (rp.idle_timeout > 0.0) {
     // Wall time: with use_sim_time the clock stops with the bag, and ROS timers with it.
     noteActivity();

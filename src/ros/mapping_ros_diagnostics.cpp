@@ -1,5 +1,7 @@
 // MappingRos's /diagnostics: one status per input (received, stale, integrating; every counter of
 // the table in input_status.h) and one for the mapper (tf failures, keeping up, map size).
+#include <ros/master.h>
+
 #include <algorithm>
 
 #include "mapping_ros_impl.h"
@@ -43,6 +45,36 @@ void MappingRos::Impl::diagnoseInput(const Input* in,
   addCounters(c, &stat);
   stat.add("measured rate (Hz)", c.rate);
   stat.add("expected rate (Hz)", expected);
+}
+
+void MappingRos::Impl::warnSilentInputs() {
+  std::string silent;
+  bool all_received = true;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& in : inputs_) {
+      if (in->c[Counter::kReceived] > 0) continue;
+      all_received = false;
+      if (in->sub.getNumPublishers() == 0) silent += (silent.empty() ? "" : ", ") + in->topic;
+    }
+  }
+  if (all_received) {
+    silent_timer_.stop();
+    return;
+  }
+  if (silent.empty()) return;  // publishers there, nothing sent yet: nothing to say
+  // The master, outside the lock.
+  ros::master::V_TopicInfo topics;
+  std::string lasers;
+  if (ros::master::getTopics(topics)) {
+    for (const auto& t : topics) {
+      if (t.datatype == "sensor_msgs/LaserScan") lasers += (lasers.empty() ? "" : ", ") + t.name;
+    }
+  }
+  ROS_WARN(
+      "%s: no scan received on %s: nothing publishes it. LaserScan topics advertised: %s; "
+      "remap the input (e.g. scan:=<topic>) or list the topic in inputs",
+      pnh_.getNamespace().c_str(), silent.c_str(), lasers.empty() ? "none" : lasers.c_str());
 }
 
 void MappingRos::Impl::diagnoseMapper(diagnostic_updater::DiagnosticStatusWrapper& stat) {

@@ -30,6 +30,7 @@
 #include "input_status.h"
 #include "map_publisher.h"
 #include "reconfigure.h"
+#include "tf_messages.h"
 #include "wavog_mapping/ClearRegion.h"
 #include "wavog_mapping/MapperStatus.h"
 #include "wavog_mapping/MappingConfig.h"
@@ -54,6 +55,8 @@ using ScanFilter = tf2_ros::MessageFilter<sensor_msgs::LaserScan>;
 
 /// Seconds between two warnings of the same input and reason.
 constexpr double kWarnPeriod = 5.0;
+/// Wall seconds between the console warnings about an input nothing publishes (warnSilentInputs).
+constexpr double kSilentInputPeriod = 10.0;
 /// Warning slots of an input (Input::last_warn) after one per drop reason.
 enum WarningSlot : std::size_t {
   kOtherWarning = kNumDropReasons,  ///< time jumps and motion fallbacks
@@ -189,6 +192,10 @@ struct MappingRos::Impl {
   // ---- /diagnostics (mapping_ros_diagnostics.cpp)
   void diagnoseInput(const Input* in, diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseMapper(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  /// Wall timer (silent_timer_): inputs without a publisher that have received nothing, warned on
+  /// the console with the LaserScan topics the master knows (a bag on /front_laser/scan against
+  /// the default `scan`); stops once every input has received a scan.
+  void warnSilentInputs();
 
   // ---- services (mapping_ros_services.cpp)
   void advertiseServices();  ///< each handler guarded: an exception is a failed answer, counted
@@ -244,7 +251,7 @@ struct MappingRos::Impl {
 
   ros::Publisher status_pub_;
   ros::ServiceServer reset_srv_, clear_srv_, save_srv_, flush_srv_, dynamic_map_srv_;
-  ros::WallTimer publish_timer_, update_timer_, diag_timer_, idle_timer_;
+  ros::WallTimer publish_timer_, update_timer_, diag_timer_, idle_timer_, silent_timer_;
   /// Serialises publications (publishAll, onUpdateTimer): taken before mutex_, never inside it.
   std::mutex publish_mutex_;
   bool windowed_warned_ = false;  ///< the fallback-window message was given (publish_mutex_)

@@ -214,9 +214,8 @@ void MappingRos::Impl::onFilterFailure(
     // Unknown: tf never came in time, or the filter's queue overflowed (it drops its oldest scan
     // when more than queue_size wait for tf).
     dropLocked(in, DropReason::kTfUnavailable,
-               "no transform to '" + placement_.fixed_frame +
-                   "' (unknown frame, tf late, or more than queue_size " +
-                   std::to_string(config_.ros.queue_size) + " scans waiting for tf)");
+               noTransformText(*buffer_, scan->header.frame_id, placement_.fixed_frame,
+                               config_.ros.queue_size));
   }
   releaseReadyLocked(in);  // the scans this one held up
 }
@@ -280,7 +279,8 @@ void MappingRos::Impl::integratePlacedScanLocked(Input* in, const sensor_msgs::L
   }
   if (placement.motion_fallback) {
     ++in->c[Counter::kMotionFallbacks];
-    warnLocked(in, kOtherWarning, "no tf at the end of the sweep: motion compensation skipped");
+    warnLocked(in, kOtherWarning,
+               motionFallbackText(config_.ros.tf_tolerance, sweepSeconds(scan)));
   }
   integrateLocked(in, scan, placement);
 }

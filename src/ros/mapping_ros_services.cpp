@@ -152,7 +152,7 @@ bool MappingRos::Impl::onSaveMap(wavog_mapping::SaveMap::Request& req,
     return fail(e.what());
   }
   res.success = true;
-  res.message = "saved " + std::to_string(res.files.size()) + " files";
+  res.message = savedMessage(res.files);  // names the folder: a relative path went below map_dir
   if (!refused.empty()) {
     res.message += "; no image of" + refused + ": more than " +
                    std::to_string(static_cast<long long>(kMaxLayerCells)) + " cells";

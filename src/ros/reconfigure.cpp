@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <sstream>
+#include <stdexcept>
 
 namespace wavog_ros {
 namespace {
@@ -74,7 +75,12 @@ Config withReconfigure(const Config& config, const wavog_mapping::MappingConfig&
                       "') must be one of: max, mean");
   }
   for (const auto& e : next.map.validate()) errors->push_back(e);
-  for (const auto& e : validate(next.ros, next.map)) errors->push_back(e);
+  // The reconfigure key of publish_scales is `scales`: a refusal names the key the user set.
+  const std::string file_key = "publish_scales";
+  for (std::string e : validate(next.ros, next.map)) {
+    if (e.compare(0, file_key.size(), file_key) == 0) e = "scales" + e.substr(file_key.size());
+    errors->push_back(e);
+  }
   return next;
 }
 
@@ -105,14 +111,20 @@ bool ReconfigureServer::onSet(dynamic_reconfigure::Reconfigure::Request& req,
   if (errors.empty()) {
     current_ = next;
     publishLocked();
-  } else {
-    std::string text;
-    for (const auto& e : errors) text += "\n  " + e;
-    ROS_ERROR("%s: reconfiguration refused, keeping the previous values:%s",
-              pnh_.getNamespace().c_str(), text.c_str());
+    current_.__toMessage__(res.config);
+    return true;
   }
-  current_.__toMessage__(res.config);
-  return true;
+  // Refused: the values in force go out again (parameter_updates, the parameter server), so that
+  // a client that showed the proposed value (rqt_reconfigure) shows the old one; the call fails
+  // with the reasons, so that `dynparam set` exits non-zero instead of returning as if it had
+  // worked.
+  // roscpp logs the exception's text as an error ("Exception thrown while processing service
+  // call: ...") and answers it to the caller.
+  publishLocked();
+  std::string text;
+  for (const auto& e : errors) text += "\n  " + e;
+  throw std::invalid_argument(pnh_.getNamespace() +
+                              ": reconfiguration refused, keeping the previous values:" + text);
 }
 
 void ReconfigureServer::publishLocked() {

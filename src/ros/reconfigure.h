@@ -32,7 +32,9 @@ Config withReconfigure(const Config& config, const wavog_mapping::MappingConfig&
 /// sees it (odd_occ: -1 arrived as the minimum and was accepted), so an out-of-range value could
 /// not be refused. Same protocol (~set_parameters, latched ~parameter_descriptions and
 /// ~parameter_updates, values mirrored on the parameter server): dynparam and rqt_reconfigure work
-/// unchanged; a refused change answers with the values in force.
+/// unchanged. A refused change fails the call with the reasons (the key as the client names it:
+/// `scales`), logs them, and publishes the values in force again: `dynparam set` exits non-zero,
+/// rqt_reconfigure shows the old value.
 class ReconfigureServer {
  public:
   /// Applies a proposed configuration, or returns why not (one line per violation; empty:

@@ -46,27 +46,45 @@ bool resolveSavePath(const std::string& dir_name, const std::string& path, std::
       return false;
     }
   }
-  const fs::path dir = fs::path(dir_text).lexically_normal();
-  const fs::path full = (given.is_absolute() ? given : dir / given).lexically_normal();
-  if (!full.has_filename() || full == dir || !isBelow(full, dir)) {
-    *error = "path '" + path + "' is not a file below " + where + ": refused";
+  std::error_code ec;
+  // Absolute (a relative $ROS_HOME is the node's working directory's).
+  const fs::path dir = fs::absolute(fs::path(dir_text), ec).lexically_normal();
+  if (ec) {
+    *error = where + ": " + ec.message();
     return false;
   }
+  const fs::path full = (given.is_absolute() ? given : dir / given).lexically_normal();
   // The existing part, symlinks followed, must stay below the directory (itself resolved).
-  std::error_code ec;
   const fs::path real_dir = fs::weakly_canonical(dir, ec);
   const fs::path real_full = ec ? fs::path() : fs::weakly_canonical(full, ec);
   if (ec) {
     *error = "path '" + path + "': " + ec.message();
     return false;
   }
-  if (!isBelow(real_full, real_dir) || real_full == real_dir) {
+  // An absolute path names a file below map_dir as written, or once the symlinks of both are
+  // followed (map_dir through a symlink, the path by its real folder, or the other way round).
+  const bool below = isBelow(full, dir) || (given.is_absolute() && isBelow(real_full, real_dir));
+  if (!full.has_filename() || full == dir || real_full == real_dir || !below) {
+    *error = "path '" + path + "' is not a file below " + where + " (" + dir.string() +
+             "; a relative path is taken below it): refused";
+    return false;
+  }
+  if (!isBelow(real_full, real_dir)) {
     *error = "path '" + path + "' leads to '" + real_full.string() + "' (through a symlink), outside " +
              where + ": refused";
     return false;
   }
   *resolved = full.string();
   return true;
+}
+
+std::string savedMessage(const std::vector<std::string>& files) {
+  std::string text =
+      "saved " + std::to_string(files.size()) + (files.size() == 1 ? " file" : " files");
+  if (files.empty()) return text;
+  text += " in " + fs::path(files[0]).parent_path().string() + ":";
+  for (const std::string& f : files) text += " " + fs::path(f).filename().string();
+  return text;
 }
 
 }  // namespace wavog_ros

@@ -163,7 +163,7 @@ wavog_ros::Config loadConfig(const Options& o, std::vector<std::string>* unknown
     }
   }
   if (!o.policy.empty()) root["policy"] = o.policy;
-  if (o.resolution > 0.0) root["resolution"] = o.resolution;
+  if (o.resolution != 0.0) root["resolution"] = o.resolution;
   if (o.threads >= 0) root["num_threads"] = o.threads;
   if (o.reflection) root["reflection"] = true;
   if (!o.aggregation.empty()) root["scale_aggregation"] = o.aggregation;
@@ -320,6 +320,12 @@ Json summaryOf(const Options& o, const wavog_ros::Config& config, const InputInf
 /// range, the output folder made.
 wavog_ros::Config prepare(const Options& o) {
   if (!(o.snapshot_every >= 0.0)) throw std::invalid_argument("--snapshot-every must be >= 0");
+  if (!(o.resolution >= 0.0)) {  // 0 keeps the YAML's; the loader checks the range of the rest
+    std::ostringstream v;
+    v << o.resolution;
+    throw std::invalid_argument("--resolution (" + v.str() +
+                                ") must be > 0 m, the finest cell size (0: the YAML's)");
+  }
   if (!o.laser_pose.empty() && o.laser_parent.empty()) {
     throw std::invalid_argument("--laser-pose needs --laser-parent (the frame it is given in)");
   }

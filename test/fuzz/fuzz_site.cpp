@@ -151,6 +151,9 @@ void checkVehicles(FuzzedDataProvider* in) {
       v.in_region = in->ConsumeBool();
       v.outside_region = in->ConsumeBool() ? in->ConsumeIntegral<std::uint64_t>()
                                            : in->ConsumeIntegralInRange<std::uint64_t>(0, 9);
+      v.received = in->ConsumeBool() ? in->ConsumeIntegral<std::uint64_t>()
+                                     : in->ConsumeIntegralInRange<std::uint64_t>(0, 9);
+      v.lost = in->ConsumeIntegralInRange<std::uint64_t>(0, 3);
       s->vehicles.push_back(v);
     }
     statuses.push_back(s);
@@ -164,20 +167,33 @@ void checkVehicles(FuzzedDataProvider* in) {
                      "an incomplete summary names vehicles");
     return;
   }
-  // Per vehicle: listed by every shard (by entries), the smallest count.
-  std::map<std::string, std::pair<std::size_t, std::uint64_t>> seen;
-  for (const auto& s : statuses) {
-    for (const auto& v : s->vehicles) {
-      auto& e = seen.emplace(v.vehicle, std::make_pair(std::size_t{0},
-                                                       std::numeric_limits<std::uint64_t>::max()))
-                    .first->second;
-      ++e.first;
-      e.second = std::min(e.second, v.outside_region);
+  // Per vehicle: listed by every shard (by entries); the most scans a shard saw (received +
+  // lost), less what a shard mapped (integrated - outside_region), smallest over the shards (a
+  // shard's last entry of the vehicle counts).
+  using u128 = unsigned __int128;
+  std::map<std::string, std::size_t> listed;
+  std::vector<std::map<std::string, u128>> seen(statuses.size()), mapped(statuses.size());
+  for (std::size_t i = 0; i < statuses.size(); ++i) {
+    for (const auto& v : statuses[i]->vehicles) {
+      ++listed[v.vehicle];
+      seen[i][v.vehicle] =
+          std::min<u128>(u128{v.received} + v.lost, std::numeric_limits<std::uint64_t>::max());
+      mapped[i][v.vehicle] = v.integrated - std::min(v.integrated, v.outside_region);
     }
   }
-  unsigned __int128 sum = 0;
-  for (const auto& kv : seen) {
-    if (kv.second.first == statuses.size()) sum += kv.second.second;
+  std::map<std::string, u128> sent;
+  for (const auto& shard : seen) {
+    for (const auto& kv : shard) sent[kv.first] = std::max(sent[kv.first], kv.second);
+  }
+  u128 sum = 0;
+  for (const auto& kv : listed) {
+    if (kv.second != statuses.size()) continue;
+    u128 fewest = std::numeric_limits<std::uint64_t>::max();
+    for (std::size_t i = 0; i < statuses.size(); ++i) {
+      const u128 m = mapped[i].count(kv.first) ? mapped[i][kv.first] : 0;
+      fewest = std::min(fewest, sent[kv.first] - std::min(sent[kv.first], m));
+    }
+    sum += fewest;
   }
   const std::uint64_t bound = sum > std::numeric_limits<std::uint64_t>::max()
                                   ? std::numeric_limits<std::uint64_t>::max()
@@ -186,7 +202,7 @@ void checkVehicles(FuzzedDataProvider* in) {
                    static_cast<unsigned long long>(site.scans_mapped_by_none_max),
                    static_cast<unsigned long long>(bound));
   for (const auto& v : site.outside) {
-    WAVOG_FUZZ_CHECK(seen.count(v.vehicle) && seen[v.vehicle].first == statuses.size(),
+    WAVOG_FUZZ_CHECK(listed.count(v.vehicle) && listed[v.vehicle] == statuses.size(),
                      "vehicle '%s' named outside but not listed by every shard", v.vehicle.c_str());
   }
 }

@@ -45,6 +45,7 @@ for f in setup.bash \
     lib/wavog_mapping/wavog_mapping_node lib/wavog_mapping/wavog_static_tf \
     lib/wavog_mapping/wavog_offline lib/wavog_mapping/wavog_log2bag \
     lib/wavog_mapping/wavog_simulate lib/wavog_mapping/wavog_evaluate \
+    lib/wavog_mapping/wavog_rviz \
     include/wavog_mapping/core/wavelet_map.h include/wavog_mapping/core/params.h \
     include/wavog_mapping/MapperStatus.h include/wavog_mapping/InputStatus.h \
     include/wavog_mapping/SaveMap.h include/wavog_mapping/ClearRegion.h \
@@ -104,6 +105,30 @@ for launch in mapping.launch mapping_node.launch playback.launch; do
 done
 echo "install_test: map_frame: the config's value holds unless given as an argument"
 
+# The nodelet and the node start with the same configuration by default (issue 41).
+nodelet_params=$(ros_env "roslaunch --dump-params wavog_mapping mapping.launch" | sort)
+node_params=$(ros_env "roslaunch --dump-params wavog_mapping mapping_node.launch" | sort)
+[ "$nodelet_params" = "$node_params" ] ||
+  { diff <(echo "$nodelet_params") <(echo "$node_params") || true
+    fail "mapping.launch and mapping_node.launch default to different configurations"; }
+echo "install_test: mapping.launch and mapping_node.launch: the same default configuration"
+
+# rviz:=true: rviz's fixed frame is the map frame, the config's or map_frame:= (issue 41), as the
+# launch starts it (its command line, run with a stand-in rviz that prints its arguments).
+mkdir -p "$work/fake_rviz"
+printf '#!/bin/sh\necho "rviz $*"\n' >"$work/fake_rviz/rviz"
+chmod +x "$work/fake_rviz/rviz"
+for launch in mapping.launch mapping_node.launch playback.launch; do
+  for case in "odom:" "world:map_frame:=world"; do
+    want=${case%%:*} given=${case#*:}
+    cmd=$(ros_env "roslaunch --args /rviz wavog_mapping $launch rviz:=true config:=$work/odom.yaml bag:=/none $given")
+    got=$(ros_env "PATH='$work/fake_rviz':\$PATH; $cmd")
+    echo "$got" | grep -Eq -- "-f $want( |\$)" ||
+      fail "$launch $given: rviz does not get the fixed frame $want: $cmd -> $got"
+  done
+done
+echo "install_test: rviz:=true: rviz's fixed frame is the map frame"
+
 ros_env "rosrun wavog_mapping wavog_simulate --duration 4 --out '$work/scenario.bag'" >"$work/simulate.log" 2>&1 ||
   { cat "$work/simulate.log"; fail "wavog_simulate"; }
 
@@ -133,7 +158,7 @@ run_case() {
   grep -h 'wait_for_map' "$log.wait"
   echo "install_test: $name: ok"
 }
-run_case mapping "mapping.launch use_sim_time:=true" ""
+run_case mapping "mapping.launch use_sim_time:=true" "scan_front_left:=scan"
 run_case mapping_node "mapping_node.launch use_sim_time:=true" "scan_front_left:=scan"
 # No tf in the bag at all: the laser held fixed to the map frame by wavog_static_tf.
 run_case fixed_frame_laser \

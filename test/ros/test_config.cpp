@@ -2,6 +2,7 @@
 // defaults key by key, unknown keys are reported, bad values name the parameter and its range.
 #include <dirent.h>
 #include <gtest/gtest.h>
+#include <ros/names.h>
 
 #include <algorithm>
 #include <fstream>
@@ -179,10 +180,20 @@ TEST(Config, FleetRegionIsTheCoresBlockRegionOrAClearError) {
             std::string::npos);
   EXPECT_NE(errorOf("{fleet_region: [0, 0, .nan, 1]}").find("fleet_region"), std::string::npos);
   EXPECT_NE(errorOf("{fleet_region: 3}").find("'fleet_region'"), std::string::npos);
-  // Beyond the extent: the core's rule names it.
-  EXPECT_NE(
-      errorOf("{resolution: 1, block_levels: 2, fleet_region: [0, 0, 4e9, 4]}").find("region"),
-      std::string::npos);
+  // Beyond the extent (issue 42): fleet_region names it and the extent, not the core's
+  // "region (blocks ...)".
+  for (const std::string yaml : {"{resolution: 1, block_levels: 2, fleet_region: [0, 0, 4e9, 4]}",
+                                 "{block_levels: 7, fleet_region: [0, 0, 1.0e+12, 6.4]}",
+                                 "{block_levels: 7, fleet_region: [-53687097.6, 0, 6.4, 6.4]}"}) {
+    const std::string why = errorOf(yaml);
+    EXPECT_NE(why.find(form), std::string::npos) << why;
+    EXPECT_NE(why.find("beyond the map's extent"), std::string::npos) << why;
+    EXPECT_EQ(why.find("region (blocks"), std::string::npos) << why;
+  }
+  // The extent itself: 2^30 cells of 5 cm, 53,687,091.2 m.
+  const std::string edge = "{block_levels: 7, fleet_region: [-53687091.2, 0, 6.4, 6.4]}";
+  EXPECT_EQ(errorOf(edge), "");
+  EXPECT_FALSE(fromYaml(edge).map.region.all);
 }
 
 TEST(Config, FleetWindowIsBoundedByTheLayerLimit) {
@@ -245,6 +256,49 @@ TEST(Config, BadValuesNameTheParameterAndItsRange) {
   EXPECT_NE(errorOf("num_threads: -1").find("num_threads (-1) must be an integer in [0, 256]"),
             std::string::npos);
   EXPECT_NE(errorOf("inputs: [{topic: a, rate: 3}]").find("unknown key 'rate'"), std::string::npos);
+}
+
+// Issue 41, item 8: a bad resolution is one error (the limits that depend on it are not checked
+// with it); a number YAML 1.1 reads as a string says so.
+TEST(Config, ABadResolutionIsOneErrorAndYaml11NumbersGetAHint) {
+  for (const std::string yaml :
+       {"resolution: -1", "resolution: 0", "resolution: .nan",
+        "{resolution: -1, fleet_window: 4, fleet_region: [0, 0, 6.4, 6.4]}"}) {
+    const std::string why = errorOf(yaml);
+    std::size_t lines = 0;
+    for (std::size_t at = why.find("\n  "); at != std::string::npos;
+         at = why.find("\n  ", at + 1)) {
+      ++lines;
+    }
+    EXPECT_EQ(lines, 1u) << yaml << ": " << why;
+    EXPECT_NE(why.find("resolution"), std::string::npos) << why;
+    EXPECT_EQ(why.find("fleet_window"), std::string::npos) << why;
+  }
+  // rosparam's YAML 1.1 hands 5e-2 over as the string "5e-2".
+  const std::string why = errorOf("resolution: '5e-2'");
+  EXPECT_NE(why.find("parameter 'resolution' ('5e-2') must be a number: YAML 1.1"),
+            std::string::npos)
+      << why;
+  EXPECT_NE(why.find("write 0.05 or 5.0e-2"), std::string::npos) << why;
+  EXPECT_NE(errorOf("gamma: '1e-1'").find("write 0.1 or 1.0e-1"), std::string::npos);
+  EXPECT_NE(errorOf("gamma: '2.5e3'").find("write 2500 or 2.5e+3"), std::string::npos);
+  EXPECT_EQ(errorOf("gamma: abc").find("YAML 1.1"), std::string::npos);
+}
+
+// Issue 41, item 6: two inputs that are one topic once resolved are refused naming inputs.
+TEST(Config, InputsThatResolveToOneTopicAreRefused) {
+  const auto in_ns = [](const std::string& ns) {
+    return [ns](const std::string& t) { return ros::names::resolve(ns, t, false); };
+  };
+  const Config c = fromYaml("inputs: [{topic: scan}, {topic: /scan}]");  // valid as written
+  const std::string why = duplicateInputs(c.ros.inputs, in_ns("/"));
+  EXPECT_EQ(why,
+            "inputs[0].topic ('scan') and inputs[1].topic ('/scan') are one topic, /scan, in "
+            "this namespace: every scan would be integrated twice; list each topic once in "
+            "inputs");
+  EXPECT_EQ(duplicateInputs(c.ros.inputs, in_ns("/robot")), "");  // /robot/scan and /scan
+  EXPECT_NE(duplicateInputs(fromYaml("inputs: [a, b, /robot/a]").ros.inputs, in_ns("/robot")), "");
+  EXPECT_EQ(duplicateInputs(fromYaml("inputs: [a, b, c, d]").ros.inputs, in_ns("/")), "");
 }
 
 TEST(Config, MissingOrMalformedFileIsAClearError) {

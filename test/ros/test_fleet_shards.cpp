@@ -285,7 +285,11 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   }
   EXPECT_EQ(site_diag.get("scans mapped by no shard (at most)"), v4_count);
   EXPECT_EQ(site_diag.get("vehicles outside every region"), "1");
-  EXPECT_EQ(site_diag.get("outside every region"), "/v4");
+  // "/v4", or "/v4 (silent)" once it is stale in both shards (5 s after its last scan).
+  EXPECT_EQ(site_diag.get("outside every region").rfind("/v4", 0), 0u)
+      << site_diag.get("outside every region");
+  EXPECT_EQ(site_diag.get("overlapping regions"), "0");  // the regions share an edge only
+  EXPECT_EQ(site_diag.get("shard restarts"), "0");
   EXPECT_EQ(site_diag.get("layers refused: bad layer"), "0");
   EXPECT_EQ(site_diag.get("layers refused: shards disagree"), "0");
   EXPECT_EQ(site_diag.get("layers refused: over max_cells"), "0");
@@ -359,9 +363,10 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
   const auto [window_differ, window_known] = gridDiff(*win, *all_map.get());
   EXPECT_EQ(window_differ, 0u) << "of " << win->data.size();
   EXPECT_GT(window_known, 1000u);
-  // 8 m each side of v1's latest position at 10 cm.
-  EXPECT_NEAR(win->info.width, 160, 2);
-  EXPECT_NEAR(win->info.height, 160, 2);
+  // 8 m each side of v1's cell at 10 cm: 2 x 80 + 1 cells wherever v1 is in its cell (issue 42:
+  // 160 to 162 before).
+  EXPECT_EQ(win->info.width, 161u);
+  EXPECT_EQ(win->info.height, 161u);
   const auto site = site_scale.get();
   const auto scale = all_scale.get();
   const auto [site_differ, site_known] = gridDiff(*site, *scale);
@@ -393,6 +398,22 @@ TEST(FleetShards, ShardsWindowsAndSiteLayersEqualTheOneFleetMap) {
       gridDiff(*sw, *all_map.get(), wavog::CellBox{384, -1000000, 1000000, 1000000});
   EXPECT_EQ(east_known_cells, 0u) << "shard_a's window holds cells east of its region";
   std::printf("shard_a's window of v1: %zu known cells\n", shard_known);
+
+  // ---- v4 goes silent (stale in both shards): wavog_site keeps it listed (issue 42: it dropped
+  // out of /diagnostics), marked silent, and its count stays.
+  const ros::WallTime silent_until = ros::WallTime::now() + ros::WallDuration(20.0);
+  while (ros::WallTime::now() < silent_until &&
+         site_diag.get("outside every region") != "/v4 (silent)") {
+    ros::WallDuration(0.2).sleep();
+  }
+  for (int i = 1; i <= 2; ++i) {
+    for (const auto& v : status[i].get()->vehicles) {
+      if (v.vehicle == "/v4") EXPECT_TRUE(v.stale) << kNodes[static_cast<std::size_t>(i)];
+    }
+  }
+  EXPECT_EQ(site_diag.get("outside every region"), "/v4 (silent)");
+  EXPECT_EQ(site_diag.get("vehicles outside every region"), "1");
+  EXPECT_EQ(site_diag.get("scans mapped by no shard (at most)"), v4_count);
 
   // ---- a shard restarts and catches up from its own ~save_map (map_file): its map is that map,
   // cell for cell, before any scan reaches it.

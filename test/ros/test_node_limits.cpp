@@ -175,6 +175,43 @@ TEST_F(SavePath, RelativeAndAbsoluteBelowMapDir) {
   ASSERT_TRUE(wavog_ros::resolveSavePath(dir_.string(), "new/dir/m.wavog", &resolved, &error));
 }
 
+// Issue 41, item 9: an absolute path inside map_dir is accepted also where map_dir or the path
+// goes through a symlink; a relative map_dir (a relative $ROS_HOME) still gives an absolute file.
+TEST_F(SavePath, AbsolutePathsInsideMapDirThroughSymlinks) {
+  std::filesystem::create_directories(dir_ / "real");
+  ASSERT_EQ(::symlink((dir_ / "real").c_str(), (dir_ / "alias").c_str()), 0);
+  std::string resolved, error;
+  EXPECT_TRUE(wavog_ros::resolveSavePath((dir_ / "alias").string(),
+                                         (dir_ / "real" / "m.wavog").string(), &resolved, &error))
+      << error;
+  EXPECT_EQ(resolved, (dir_ / "real" / "m.wavog").string());
+  EXPECT_TRUE(wavog_ros::resolveSavePath(
+      (dir_ / "real").string(), (dir_ / "alias" / "sub" / "m.wavog").string(), &resolved, &error))
+      << error;
+  EXPECT_EQ(resolved, (dir_ / "alias" / "sub" / "m.wavog").string());
+  // Still refused: the folder itself, and beside it.
+  EXPECT_FALSE(wavog_ros::resolveSavePath((dir_ / "alias").string(), (dir_ / "real").string(),
+                                          &resolved, &error));
+  EXPECT_FALSE(wavog_ros::resolveSavePath((dir_ / "alias").string(), (dir_ / "m.wavog").string(),
+                                          &resolved, &error));
+  EXPECT_NE(error.find("not a file below map_dir '" + (dir_ / "alias").string() + "'"),
+            std::string::npos)
+      << error;
+
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir_);
+  const bool ok = wavog_ros::resolveSavePath("rel", "saved/m.wavog", &resolved, &error);
+  std::filesystem::current_path(cwd);
+  ASSERT_TRUE(ok) << error;
+  EXPECT_EQ(resolved, (dir_ / "rel" / "saved" / "m.wavog").string());
+
+  // The answer names the folder the files went to.
+  EXPECT_EQ(
+      wavog_ros::savedMessage({"/root/.ros/saved/robot.wavog", "/root/.ros/saved/robot_s0.pgm"}),
+      "saved 2 files in /root/.ros/saved: robot.wavog robot_s0.pgm");
+  EXPECT_EQ(wavog_ros::savedMessage({"/tmp/m.wavog"}), "saved 1 file in /tmp: m.wavog");
+}
+
 TEST_F(SavePath, RefusedOutsideMapDir) {
   ASSERT_EQ(::symlink("/etc", (dir_ / "escape").c_str()), 0);
   const std::string prefix = dir_.string() + "_other/m.wavog";  // shares the prefix text only

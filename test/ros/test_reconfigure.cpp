@@ -100,4 +100,15 @@ TEST(ReconfigureRanges, PolicyAndInitBothWays) {
   EXPECT_EQ(errors[2].compare(0, 5, "init "), 0) << errors[2];
 }
 
+// Issue 41: a refused scale names the reconfigure key, `scales`, not the file's publish_scales.
+TEST(Reconfigure, ARefusedScaleNamesTheKeyScales) {
+  const wavog_ros::Config base;
+  MappingConfig rc = wavog_ros::toReconfigure(base);
+  rc.scales = "2,13";
+  std::vector<std::string> errors;
+  wavog_ros::withReconfigure(base, rc, &errors);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].rfind("scales entry (13) must be in [1, block_levels", 0), 0u) << errors[0];
+}
+
 }  // namespace

@@ -9,9 +9,10 @@
 #include <cmath>
 #include <vector>
 
+#include "driving_laser.h"
+#include "tf_messages.h"
 #include "wavog_mapping/core/motion_compensation.h"
 #include "wavog_mapping/core/wavelet_map.h"
-#include "driving_laser.h"
 #include "wavog_mapping/ros/scan_placement.h"
 
 namespace {
@@ -138,6 +139,43 @@ TEST(ScanPlacement, CompensationOffOrUntimedBeamsUseTheStampOnly) {
     EXPECT_NEAR(p.start.x, kMount + kSpeed * 0.5, 1e-9);
     EXPECT_EQ(p.end.x, p.start.x);
   }
+}
+
+// Issue 41: what the node says when tf cannot place a scan names the frame tf lacks (the
+// laser's, not the map frame that exists) and the frames tf has; a skipped motion compensation
+// names tf_tolerance against the sweep.
+TEST(TfMessages, NameTheMissingFrameAndTheFramesTfHas) {
+  const DrivingTf tf;  // map <- base_link <- laser_down
+  std::string text = wavog_ros::noTransformText(tf, "laser", "map", 10);
+  EXPECT_NE(text.find("the scan's frame 'laser' is not in tf"), std::string::npos) << text;
+  EXPECT_NE(text.find("frames tf has: base_link, laser_down, map"), std::string::npos) << text;
+  EXPECT_NE(text.find("laser_parent:=<frame> laser_frame:=laser"), std::string::npos) << text;
+  text = wavog_ros::noTransformText(tf, "laser_down", "odom", 10);
+  EXPECT_NE(text.find("the map frame 'odom' is not in tf"), std::string::npos) << text;
+  // Known frames, a scan stamp tf does not reach: neither frame is missing.
+  text = wavog_ros::noTransformText(tf, "laser_down", "map", 7);
+  EXPECT_NE(text.find("at the scan's stamp"), std::string::npos) << text;
+  EXPECT_NE(text.find("queue_size 7"), std::string::npos) << text;
+  EXPECT_EQ(text.find("not in tf"), std::string::npos) << text;
+  // Two trees tf does not join.
+  tf2::BufferCore apart;
+  apart.setTransform(driving_laser::transform("map", "base_link", 0, 0, 0, kT0), "test", true);
+  apart.setTransform(driving_laser::transform("odom", "laser", 0, 0, 0, kT0), "test", true);
+  text = wavog_ros::noTransformText(apart, "laser", "map", 10);
+  EXPECT_NE(text.find("tf does not connect them (frames tf has: base_link, laser, map, odom)"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(wavog_ros::framesOf(tf2::BufferCore()), "none");
+  EXPECT_EQ(wavog_ros::framesOf(apart, 2), "base_link, laser and 2 more");
+}
+
+TEST(TfMessages, ASkippedCompensationNamesTfToleranceAndTheSweep) {
+  const std::string text = wavog_ros::motionFallbackText(0.03, 0.99);
+  EXPECT_NE(text.find("0.99 s after the scan's stamp"), std::string::npos) << text;
+  EXPECT_NE(text.find("tf_tolerance (0.03 s)"), std::string::npos) << text;
+  EXPECT_NE(text.find("set tf_tolerance to the sweep's 0.99 s"), std::string::npos) << text;
+  // A tolerance that covers the sweep: tf was late, no advice to raise it.
+  EXPECT_EQ(wavog_ros::motionFallbackText(0.5, 0.1).find("set tf_tolerance"), std::string::npos);
 }
 
 }  // namespace

@@ -138,6 +138,20 @@ TEST_F(Services, SaveMapWritesNativeAndMapServerFiles) {
     EXPECT_GE(h, 30);
   }
 
+  // The answer says where the files went (issue 41: a relative path goes below map_dir, /tmp
+  // here, not the caller's working directory).
+  EXPECT_EQ(srv.response.message.rfind("saved 9 files in " + kDir + ": room.wavog room_s0.pgm", 0),
+            0u)
+      << srv.response.message;
+  wavog_mapping::SaveMap relative;
+  relative.request.path = kDir.substr(5) + "/rel/room.wavog";  // below map_dir: /tmp
+  ASSERT_TRUE(ros::service::call("wavog_mapping/save_map", relative));
+  EXPECT_TRUE(relative.response.success) << relative.response.message;
+  ASSERT_FALSE(relative.response.files.empty());
+  EXPECT_EQ(relative.response.files[0], kDir + "/rel/room.wavog");
+  EXPECT_NE(relative.response.message.find(" in " + kDir + "/rel: room.wavog"), std::string::npos)
+      << relative.response.message;
+
   // A missing folder is created.
   wavog_mapping::SaveMap nested;
   nested.request.path = kDir + "/new/sub/room.wavog";
@@ -335,15 +349,26 @@ TEST_F(Services, DynamicReconfigureValidatesAndApplies) {
     EXPECT_FALSE(g5) << "an empty layer never sent before was published";
   }
 
+  // A refused change fails the call (dynparam exits non-zero: issue 41) and changes nothing: the
+  // values in force stay on the parameter server, as the server mirrors them.
+  const auto in_force = [](const std::string& name) {
+    XmlRpc::XmlRpcValue v;
+    if (!ros::param::get("/wavog_mapping/" + name, v)) return std::string("?");
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      return std::to_string(static_cast<double>(v));
+    }
+    return v.getType() == XmlRpc::XmlRpcValue::TypeString ? static_cast<std::string>(v)
+                                                          : std::string("?");
+  };
   // A scale beyond block_levels (6) is refused as a whole: the previous values stay.
   dynamic_reconfigure::Reconfigure bad;
   scales.value = "2,9";
   bad.request.config.strs.push_back(scales);
   gamma.value = 0.7;
   bad.request.config.doubles.push_back(gamma);
-  ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", bad));
-  EXPECT_EQ(value(bad.response.config, "scales"), "2,5");
-  EXPECT_EQ(value(bad.response.config, "gamma"), std::to_string(0.5));
+  EXPECT_FALSE(ros::service::call("wavog_mapping/set_parameters", bad));
+  EXPECT_EQ(in_force("scales"), "2,5");
+  EXPECT_EQ(in_force("gamma"), std::to_string(0.5));
 
   // Out of the .cfg range: refused, not clamped to the range (odd_occ must be > 0).
   dynamic_reconfigure::Reconfigure negative;
@@ -353,17 +378,17 @@ TEST_F(Services, DynamicReconfigureValidatesAndApplies) {
   negative.request.config.doubles.push_back(odd_occ);
   gamma.value = 0.9;
   negative.request.config.doubles.push_back(gamma);
-  ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", negative));
-  EXPECT_EQ(value(negative.response.config, "odd_occ"), std::to_string(3.5));
-  EXPECT_EQ(value(negative.response.config, "gamma"), std::to_string(0.5));
+  EXPECT_FALSE(ros::service::call("wavog_mapping/set_parameters", negative));
+  EXPECT_EQ(in_force("odd_occ"), std::to_string(3.5));
+  EXPECT_EQ(in_force("gamma"), std::to_string(0.5));
   // An unknown policy name: refused.
   dynamic_reconfigure::Reconfigure policy;
   dynamic_reconfigure::StrParameter name;
   name.name = "policy";
   name.value = "forgett";
   policy.request.config.strs.push_back(name);
-  ASSERT_TRUE(ros::service::call("wavog_mapping/set_parameters", policy));
-  EXPECT_EQ(value(policy.response.config, "policy"), "forget");
+  EXPECT_FALSE(ros::service::call("wavog_mapping/set_parameters", policy));
+  EXPECT_EQ(in_force("policy"), "forget");
 }
 
 TEST_F(Services, SilentLaserIsReportedStale) {
@@ -428,6 +453,37 @@ TEST_F(Services, BadParameterFailsAtStartUpNamingIt) {
                              &output);
   EXPECT_EQ(code, 1) << output;
   EXPECT_NE(output.find("publish_rate (-2) must be in (0, 100] Hz"), std::string::npos) << output;
+}
+
+// Issue 41, item 6: `scan` and `/scan` in the root namespace are one topic: refused at start-up
+// naming inputs (every scan was integrated twice).
+TEST_F(Services, InputsThatAreOneTopicAreRefusedAtStartUp) {
+  XmlRpc::XmlRpcValue inputs;
+  inputs[0] = std::string("scan");
+  inputs[1] = std::string("/scan");
+  ros::param::set("/dup_inputs/inputs", inputs);
+  std::string output;
+  const int code = room::run(
+      std::string("timeout 8 ") + WAVOG_NODE_BIN + " __name:=dup_inputs map:=/dup_inputs/map",
+      &output);
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find("inputs[0].topic ('scan') and inputs[1].topic ('/scan') are one topic, "
+                        "/scan"),
+            std::string::npos)
+      << output;
+}
+
+// Issue 41, item 2: an input nothing publishes is warned on the console with the LaserScan
+// topics that exist (this test advertises /scan_1); /diagnostics alone said "no scan yet".
+TEST_F(Services, AnInputWithoutPublisherNamesTheLaserScanTopics) {
+  std::string output;
+  room::run(std::string("timeout 14 ") + WAVOG_NODE_BIN + " __ns:=/silent __name:=wavog_mapping",
+            &output);
+  EXPECT_NE(output.find("no scan received on /silent/scan: nothing publishes it. LaserScan "
+                        "topics advertised: "),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("/scan_1"), std::string::npos) << output;
 }
 
 TEST_F(Services, NodeletWithBadParameterFailsToLoadNamingIt) {

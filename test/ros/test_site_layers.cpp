@@ -3,13 +3,16 @@
 // or allocating past ~max_cells, and the vehicles outside every region from the shards' statuses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "fleet/site_layers.h"
+#include "fleet/site_params.h"
 #include "fleet/site_vehicles.h"
 
 namespace {
@@ -144,15 +147,27 @@ TEST(SiteLayers, RefusesMalformedLayers) {
   EXPECT_EQ(assemble({&good, &g}, &out), SiteRefusal::kMismatch) << "another resolution";
 }
 
-// Statuses of shards, each listing vehicles.
+// Statuses of shards, each listing vehicles: `outside` of the vehicle's scans (at least 10, all
+// received and integrated) reached no block of the shard's region.
 wavog_mapping::VehicleStatus vehicle(const std::string& name, bool in_region, std::uint64_t outside,
                                      bool stale = false) {
   wavog_mapping::VehicleStatus v;
   v.vehicle = name;
-  v.integrated = 10;
+  v.received = v.integrated = std::max<std::uint64_t>(10, outside);
   v.in_region = in_region;
   v.outside_region = outside;
   v.stale = stale;
+  return v;
+}
+
+// A vehicle's counters in one shard: `received` scans, `mapped` of them reached its region.
+wavog_mapping::VehicleStatus counted(const std::string& name, std::uint64_t received,
+                                     std::uint64_t mapped, bool in_region = false) {
+  wavog_mapping::VehicleStatus v;
+  v.vehicle = name;
+  v.received = v.integrated = received;
+  v.outside_region = received - mapped;
+  v.in_region = in_region;
   return v;
 }
 
@@ -177,7 +192,9 @@ TEST(SiteVehicles, NamesVehiclesOutsideEveryRegionAndBoundsTheirScans) {
   ASSERT_EQ(site.outside.size(), 1u);  // v1 reached /a; v3 stale in /b; v4 unknown to /a
   EXPECT_EQ(site.outside[0].vehicle, "v2");
   EXPECT_EQ(site.outside[0].per_shard, " /a: 40 /b: 38");
-  EXPECT_EQ(site.scans_mapped_by_none_max, 3u + 38u + 7u);  // v1, v2, v3: the smaller count
+  // Per vehicle, the most scans a shard saw less the most a shard mapped: v1 10 - 7, v2 40 - 0
+  // (/b saw 38 of them), v3 10 - 3.
+  EXPECT_EQ(site.scans_mapped_by_none_max, 3u + 40u + 7u);
 
   st[0] = status({vehicle("v1", false, std::numeric_limits<std::uint64_t>::max()),
                   vehicle("v2", false, std::numeric_limits<std::uint64_t>::max())});
@@ -186,6 +203,186 @@ TEST(SiteVehicles, NamesVehiclesOutsideEveryRegionAndBoundsTheirScans) {
   site = wavog_fleet::summariseVehicles(st, shards);
   EXPECT_EQ(site.scans_mapped_by_none_max, std::numeric_limits<std::uint64_t>::max());
   EXPECT_EQ(site.outside.size(), 2u);
+}
+
+// Issue 42: a shard restarts (its counters start again at 0). The scans mapped by none stay an
+// upper bound: the restarted shard's earlier life is kept, and the scans sent while it was down
+// are not mapped by it. Before, the bound was the smallest outside_region of the latest statuses:
+// here 10 (the restarted shard's new count) where 100 scans reached no shard.
+TEST(SiteVehicles, ScansMappedByNoneStayAnUpperBoundAcrossAShardRestart) {
+  const std::vector<std::string> shards = {"/a", "/b"};
+  std::vector<wavog_mapping::FleetStatus::ConstPtr> st(2);
+  wavog_fleet::ShardLives lives(2);
+  auto report = [&](std::size_t i, std::vector<wavog_mapping::VehicleStatus> v) {
+    st[i] = status(std::move(v));
+    lives.add(i, *st[i]);
+  };
+  // v1 outside every region: 50 scans, counted by both shards; v2 in /a's region.
+  report(0, {counted("v1", 50, 0), counted("v2", 50, 50, true)});
+  report(1, {counted("v1", 50, 0), counted("v2", 50, 0)});
+  EXPECT_EQ(wavog_fleet::summariseVehicles(st, shards, lives).scans_mapped_by_none_max, 50u);
+  // /a goes down; 20 more scans of each vehicle, /b alone receives them: v2's 20 are in /a's
+  // region, mapped by none.
+  report(1, {counted("v1", 70, 0), counted("v2", 70, 0)});
+  // /a restarts and receives 10 more of each.
+  report(0, {counted("v1", 10, 0), counted("v2", 10, 10, true)});
+  report(1, {counted("v1", 80, 0), counted("v2", 80, 0)});
+  const wavog_fleet::SiteVehicles site = wavog_fleet::summariseVehicles(st, shards, lives);
+  EXPECT_EQ(lives.restarts(0), 1u);
+  EXPECT_EQ(lives.restarts(1), 0u);
+  EXPECT_EQ(lives.get(0, "v2").mapped, 60u);
+  EXPECT_EQ(lives.get(0, "v2").seen, 60u);
+  // 80 of v1 and 20 of v2 reached no shard; the bound holds them all, exactly here.
+  EXPECT_EQ(site.scans_mapped_by_none_max, 80u + 20u);
+  ASSERT_EQ(site.outside.size(), 1u);
+  EXPECT_EQ(site.outside[0].vehicle, "v1");
+  // A second restart of /a keeps both earlier lives.
+  report(0, {counted("v1", 5, 0), counted("v2", 5, 5, true)});
+  EXPECT_EQ(lives.restarts(0), 2u);
+  EXPECT_EQ(lives.get(0, "v2").mapped, 65u);
+  EXPECT_EQ(wavog_fleet::summariseVehicles(st, shards, lives).scans_mapped_by_none_max,
+            80u + 80u - 65u);
+}
+
+// Scans a shard lost or refused are not mapped by it (a scan in its region it lost is mapped by
+// none).
+TEST(SiteVehicles, ScansAShardLostOrRefusedAreNotMappedByIt) {
+  const std::vector<std::string> shards = {"/a", "/b"};
+  std::vector<wavog_mapping::FleetStatus::ConstPtr> st(2);
+  wavog_mapping::VehicleStatus a = counted("v", 40, 40, true);
+  a.lost = 6;       // 6 scans in /a's region never delivered to /a
+  a.received = 44;  // 4 of them refused
+  a.dropped_bad_pose = 4;
+  st[0] = status({a});
+  st[1] = status({counted("v", 50, 0)});
+  EXPECT_EQ(wavog_fleet::summariseVehicles(st, shards).scans_mapped_by_none_max, 10u);
+}
+
+// Issue 42: a vehicle outside every region stays listed once it goes silent (stale in every
+// shard, its last scan the same in each); before, it dropped out of /diagnostics.
+TEST(SiteVehicles, AVehicleOutsideEveryRegionStaysListedOnceSilent) {
+  const std::vector<std::string> shards = {"/a", "/b"};
+  std::vector<wavog_mapping::FleetStatus::ConstPtr> st(2);
+  wavog_mapping::VehicleStatus a = vehicle("v", false, 20, /*stale=*/true);
+  wavog_mapping::VehicleStatus b = vehicle("v", false, 20, /*stale=*/true);
+  a.last_stamp = b.last_stamp = ros::Time(30.0);
+  st[0] = status({a});
+  st[1] = status({b});
+  wavog_fleet::SiteVehicles site = wavog_fleet::summariseVehicles(st, shards);
+  ASSERT_EQ(site.outside.size(), 1u);
+  EXPECT_EQ(site.outside[0].vehicle, "v");
+  EXPECT_TRUE(site.outside[0].silent);
+  // Its last scan reached /b: not outside.
+  b.in_region = true;
+  st[1] = status({b});
+  EXPECT_TRUE(wavog_fleet::summariseVehicles(st, shards).outside.empty());
+  // The shards' last scans differ (/b has not got the latest one): not known, not named.
+  b.in_region = false;
+  b.last_stamp = ros::Time(29.0);
+  st[1] = status({b});
+  EXPECT_TRUE(wavog_fleet::summariseVehicles(st, shards).outside.empty());
+  // Fresh in every shard: named, not silent.
+  a.stale = b.stale = false;
+  st[0] = status({a});
+  st[1] = status({b});
+  site = wavog_fleet::summariseVehicles(st, shards);
+  ASSERT_EQ(site.outside.size(), 1u);
+  EXPECT_FALSE(site.outside[0].silent);
+}
+
+// Issue 42: wavog_site's parameters; each bad value refused naming the parameter and its range.
+XmlRpc::XmlRpcValue siteParams(const std::string& key, const XmlRpc::XmlRpcValue& value) {
+  XmlRpc::XmlRpcValue root;
+  root["shards"][0] = std::string("shard_a");
+  root["shards"][1] = std::string("shard_b");
+  root["scales"][0] = 3;
+  if (!key.empty()) root[key] = value;
+  return root;
+}
+
+std::string refusal(const XmlRpc::XmlRpcValue& root) {
+  try {
+    wavog_fleet::readSiteParams(root);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SiteParams, RefusesEveryBadValueNamingTheParameter) {
+  const wavog_fleet::SiteParams p = wavog_fleet::readSiteParams(siteParams("", {}));
+  EXPECT_EQ(p.shards, (std::vector<std::string>{"shard_a", "shard_b"}));
+  EXPECT_EQ(p.scales, std::vector<int>{3});
+  EXPECT_EQ(p.rate, 1.0);
+  EXPECT_EQ(p.max_cells, kDefaultMaxSiteCells);
+  EXPECT_EQ(wavog_fleet::readSiteParams(siteParams("rate", 2.5)).rate, 2.5);
+  EXPECT_EQ(wavog_fleet::readSiteParams(siteParams("rate", 3)).rate, 3.0);
+  EXPECT_EQ(wavog_fleet::readSiteParams(siteParams("max_cells", 1000)).max_cells, 1000u);
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  // roslaunch hands `rate:=nan` over as the string "nan"; a YAML .nan is a double NaN.
+  for (const XmlRpc::XmlRpcValue& bad :
+       {XmlRpc::XmlRpcValue(std::string("nan")), XmlRpc::XmlRpcValue(std::string("inf")),
+        XmlRpc::XmlRpcValue(nan), XmlRpc::XmlRpcValue(inf), XmlRpc::XmlRpcValue(0.0),
+        XmlRpc::XmlRpcValue(101.0), XmlRpc::XmlRpcValue(true)}) {
+    const std::string why = refusal(siteParams("rate", bad));
+    EXPECT_NE(why.find("~rate must be a number in (0, 100] Hz"), std::string::npos) << why;
+  }
+  for (const XmlRpc::XmlRpcValue& bad :
+       {XmlRpc::XmlRpcValue(std::string("nan")), XmlRpc::XmlRpcValue(nan), XmlRpc::XmlRpcValue(inf),
+        XmlRpc::XmlRpcValue(0), XmlRpc::XmlRpcValue(2.5),
+        XmlRpc::XmlRpcValue(std::ldexp(1.0, 28) + 1.0)}) {
+    const std::string why = refusal(siteParams("max_cells", bad));
+    EXPECT_NE(why.find("~max_cells must be a"), std::string::npos) << why;
+  }
+  // scales:=[3.5] was read as 3.
+  XmlRpc::XmlRpcValue whole = siteParams("", {});
+  whole["scales"][1] = 4.0;
+  EXPECT_EQ(wavog_fleet::readSiteParams(whole).scales, (std::vector<int>{3, 4}));
+  for (const XmlRpc::XmlRpcValue& bad :
+       {XmlRpc::XmlRpcValue(3.5), XmlRpc::XmlRpcValue(0), XmlRpc::XmlRpcValue(13),
+        XmlRpc::XmlRpcValue(std::string("3"))}) {
+    XmlRpc::XmlRpcValue root = siteParams("", {});
+    root["scales"][1] = bad;
+    const std::string why = refusal(root);
+    EXPECT_NE(why.find("~scales must list the scales to assemble (each a whole number in [1, 12]"),
+              std::string::npos)
+        << why;
+  }
+  XmlRpc::XmlRpcValue no_shards = siteParams("", {});
+  no_shards["shards"] = XmlRpc::XmlRpcValue();
+  EXPECT_NE(refusal(no_shards).find("~shards must list"), std::string::npos);
+  XmlRpc::XmlRpcValue bad_shard = siteParams("", {});
+  bad_shard["shards"][1] = std::string("9 bad");
+  EXPECT_NE(refusal(bad_shard).find("~shards entry '9 bad' is not a ROS namespace"),
+            std::string::npos);
+}
+
+TEST(SiteParams, NamesOverlappingRegions) {
+  using wavog_fleet::ShardRegion;
+  const std::vector<ShardRegion> apart = {{"/a", {-64, -64, 38.4, 102.4}},
+                                          {"/b", {38.4, -64, 140.8, 102.4}}};
+  EXPECT_TRUE(wavog_fleet::overlappingRegions(apart).empty());  // they share an edge only
+  const std::vector<ShardRegion> overlap = {{"/a", {-64, -64, 44.8, 102.4}},
+                                            {"/b", {38.4, -64, 140.8, 102.4}},
+                                            {"/c", {200, 0, 300, 100}}};
+  const std::vector<std::string> o = wavog_fleet::overlappingRegions(overlap);
+  ASSERT_EQ(o.size(), 1u);
+  EXPECT_EQ(o[0], "/a [-64, -64, 44.8, 102.4] and /b [38.4, -64, 140.8, 102.4]");
+  const std::vector<ShardRegion> everything = {{"/a", {}}, {"/b", {38.4, -64, 140.8, 102.4}}};
+  ASSERT_EQ(wavog_fleet::overlappingRegions(everything).size(), 1u);
+  // fleet_region values as the parameter server holds them.
+  XmlRpc::XmlRpcValue v;
+  v[0] = 0;
+  v[1] = -6.4;
+  v[2] = 64;
+  v[3] = 6.4;
+  std::vector<double> r;
+  ASSERT_TRUE(wavog_fleet::readRegion(v, &r));
+  EXPECT_EQ(r, (std::vector<double>{0, -6.4, 64, 6.4}));
+  v[3] = std::string("x");
+  EXPECT_FALSE(wavog_fleet::readRegion(v, &r));
 }
 
 }  // namespace

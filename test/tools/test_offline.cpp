@@ -549,6 +549,14 @@ TEST(Offline, ClearErrors) {
   r = run(WAVOG_OFFLINE, "--no-progress --resolution 0.05x -o " + out + " " + bag);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("--resolution: not a number: '0.05x'"), std::string::npos) << r.err;
+  // A negative resolution is refused by name (issue 41: it mapped at the YAML's, exit 0); 0 keeps
+  // the YAML's.
+  r = run(WAVOG_OFFLINE, "--no-progress --resolution -1 -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--resolution (-1) must be > 0 m"), std::string::npos) << r.err;
+  r = run(WAVOG_OFFLINE, "--no-progress --resolution 500 -o " + out + " " + bag);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("resolution (500) must be"), std::string::npos) << r.err;
   r = run(WAVOG_OFFLINE,
           "--no-progress --laser-parent base_link --laser-pose \"0 0 1\" -o " + out + " " + bag);
   EXPECT_EQ(r.status, 1);

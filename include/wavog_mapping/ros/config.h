@@ -8,6 +8,7 @@
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -154,12 +155,19 @@ const char* toString(wavog::Aggregation aggregation);
 bool fromString(const std::string& name, wavog::Aggregation* aggregation);
 
 /// fleet_region (m) as the blocks of a map of `grid` (`region` must hold 4 values): false, with
-/// *why, when they are not finite, min < max and multiples of the block size.
+/// *why, when they are not finite, min < max, multiples of the block size and within the map's
+/// extent (finest cell indices within +-2^30, as MapParams::region).
 bool fleetRegionBlocks(const std::vector<double>& region, const wavog::GridParams& grid,
                        wavog::BlockRegion* out, std::string* why);
 
 /// Every violation of the ROS parameters (given the core parameters), one line each.
 std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& map);
+
+/// Two inputs naming one topic once resolved by `resolve` (the node handle's resolveName: its
+/// namespace and remappings; `scan` and `/scan` in the root namespace): the error naming
+/// `inputs`, empty when every input is a topic of its own.
+std::string duplicateInputs(const std::vector<InputConfig>& inputs,
+                            const std::function<std::string(const std::string&)>& resolve);
 
 }  // namespace wavog_ros
 

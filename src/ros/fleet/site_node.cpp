@@ -4,9 +4,12 @@
 // so that a dispatcher sees the whole site without the fine grid of all of it. It also follows
 // each shard's <shard>/wavog_fleet/fleet_status (site_vehicles.h) and warns (throttled, per
 // vehicle) about a vehicle whose latest scan reached no shard's region: outside every region, its
-// scans are mapped by no shard. Bad parameters fail at start-up, naming the parameter and its
-// range; layers that cannot be put together are refused (counted by reason, warned with a
-// throttle, not published). Counters and the vehicles outside every region go to /diagnostics.
+// scans are mapped by no shard (also once it is silent); the scans mapped by none stay an upper
+// bound when a shard restarts (ShardLives). Bad parameters fail at start-up, naming the parameter
+// and its range (site_params.h); shards whose fleet_region parameters overlap are warned about
+// once all are known. Layers that cannot be put together are refused (counted by reason, warned
+// with a throttle, not published). Counters and the vehicles outside every region go to
+// /diagnostics.
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "site_layers.h"
+#include "site_params.h"
 #include "site_vehicles.h"
 #include "wavog_mapping/FleetStatus.h"
 
@@ -38,9 +42,34 @@ struct Refusals {
   std::string last;  ///< the latest refusal's text
 };
 
-[[noreturn]] void fail(const std::string& text) {
-  ROS_FATAL("wavog_site: %s", text.c_str());
-  throw std::invalid_argument(text);
+// Reads every shard's fleet_region; once all are known (true), *overlaps lists the overlapping
+// pairs, each warned. A shard not heard from yet (no status) whose parameter is not set: false,
+// read again later; one heard from without the parameter has no region.
+bool checkRegions(const ros::NodeHandle& nh, const std::vector<std::string>& shards,
+                  const std::vector<wavog_mapping::FleetStatus::ConstPtr>& statuses,
+                  std::vector<std::string>* overlaps) {
+  std::vector<wavog_fleet::ShardRegion> regions;
+  for (std::size_t i = 0; i < shards.size(); ++i) {
+    const std::string key =
+        nh.resolveName(ros::names::append(shards[i], "wavog_fleet/fleet_region"));
+    XmlRpc::XmlRpcValue value;
+    wavog_fleet::ShardRegion r;
+    r.shard = shards[i];
+    if (ros::param::get(key, value)) {
+      if (!wavog_fleet::readRegion(value, &r.region)) return false;  // the shard refuses it
+    } else if (!statuses[i]) {
+      return false;
+    }
+    regions.push_back(r);
+  }
+  *overlaps = wavog_fleet::overlappingRegions(regions);
+  for (const std::string& o : *overlaps) {
+    ROS_WARN(
+        "wavog_site: the regions of %s overlap: cells there are mapped by both shards (the "
+        "site layer takes one); give each shard a fleet_region of its own",
+        o.c_str());
+  }
+  return true;
 }
 
 }  // namespace
@@ -53,35 +82,15 @@ int main(int argc, char** argv) {
   double rate = 1.0;
   std::uint64_t max_cells = wavog_fleet::kDefaultMaxSiteCells;
   try {
-    if (!pnh.getParam("shards", shards) || shards.empty()) {
-      fail("~shards must list the shards' namespaces (at least one)");
-    }
-    for (const std::string& shard : shards) {
-      std::string error;
-      if (!ros::names::validate(shard, error)) {
-        fail("~shards entry '" + shard + "' is not a ROS namespace: " + error);
-      }
-    }
-    if (!pnh.getParam("scales", scales) || scales.empty()) {
-      fail(
-          "~scales must list the scales to assemble (each in [1, 12], published by every shard "
-          "in publish_scales)");
-    }
-    for (int s : scales) {
-      if (s < 1 || s > 12) fail("~scales entry (" + std::to_string(s) + ") must be in [1, 12]");
-    }
-    pnh.param("rate", rate, 1.0);
-    if (!(rate > 0.0 && rate <= 100.0)) {
-      fail("~rate (" + std::to_string(rate) + ") must be in (0, 100] Hz");
-    }
-    double cells = static_cast<double>(max_cells);
-    pnh.param("max_cells", cells, cells);
-    if (!(cells >= 1.0 && cells <= static_cast<double>(wavog_fleet::kMaxSiteCellsLimit))) {
-      fail("~max_cells (" + std::to_string(cells) + ") must be in [1, " +
-           std::to_string(wavog_fleet::kMaxSiteCellsLimit) + "] cells per site layer");
-    }
-    max_cells = static_cast<std::uint64_t>(cells);
-  } catch (const std::invalid_argument&) {
+    XmlRpc::XmlRpcValue root;
+    if (!pnh.getParam(pnh.getNamespace(), root)) root = XmlRpc::XmlRpcValue();
+    const wavog_fleet::SiteParams p = wavog_fleet::readSiteParams(root);
+    shards = p.shards;
+    scales = p.scales;
+    rate = p.rate;
+    max_cells = p.max_cells;
+  } catch (const std::invalid_argument& e) {
+    ROS_FATAL("wavog_site: %s", e.what());
     return 1;
   }
   std::map<int, Scale> layers;
@@ -100,13 +109,22 @@ int main(int argc, char** argv) {
     }
   }
   // Per shard, the latest ~fleet_status.
+  // Per shard, the latest ~fleet_status; every status adds to the shards' lives (restarts).
   std::vector<wavog_mapping::FleetStatus::ConstPtr> statuses(shards.size());
+  wavog_fleet::ShardLives lives(shards.size());
   std::vector<ros::Subscriber> status_subs;
   for (std::size_t i = 0; i < shards.size(); ++i) {
     status_subs.push_back(nh.subscribe<wavog_mapping::FleetStatus>(
         ros::names::append(shards[i], "wavog_fleet/fleet_status"), 2,
-        [&statuses, i](const wavog_mapping::FleetStatus::ConstPtr& m) { statuses[i] = m; }));
+        [&statuses, &lives, i](const wavog_mapping::FleetStatus::ConstPtr& m) {
+          statuses[i] = m;
+          lives.add(i, *m);
+        }));
   }
+  // The shards' regions (<shard>/wavog_fleet/fleet_region), read once every shard's is there:
+  // overlapping regions warned once, and in /diagnostics.
+  std::vector<std::string> overlaps;
+  bool regions_read = false;
 
   wavog_fleet::SiteVehicles site;
   std::map<std::string, ros::WallTime> warned;
@@ -120,7 +138,8 @@ int main(int argc, char** argv) {
   ros::WallTime silent_warned;
   ros::WallTimer status_timer =
       nh.createWallTimer(ros::WallDuration(1.0), [&](const ros::WallTimerEvent&) {
-        site = wavog_fleet::summariseVehicles(statuses, shards);
+        site = wavog_fleet::summariseVehicles(statuses, shards, lives);
+        if (!regions_read) regions_read = checkRegions(nh, shards, statuses, &overlaps);
         const ros::WallTime now = ros::WallTime::now();
         silent.clear();
         for (const auto& kv : layers) {
@@ -148,9 +167,9 @@ int main(int argc, char** argv) {
           if (it != warned.end() && (now - it->second).toSec() < 5.0) continue;
           warned[v.vehicle] = now;
           ROS_WARN(
-              "wavog_site: vehicle '%s' is outside every region: its latest scan reached no "
+              "wavog_site: vehicle '%s' is outside every region%s: its latest scan reached no "
               "shard, its scans there are mapped by none (outside_region per shard:%s)",
-              v.vehicle.c_str(), v.per_shard.c_str());
+              v.vehicle.c_str(), v.silent ? " (silent since)" : "", v.per_shard.c_str());
         }
       });
 
@@ -193,6 +212,8 @@ int main(int argc, char** argv) {
     if (!silent.empty() && (ros::WallTime::now() - started).toSec() >= kSilentAfter) {
       s.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                 "no publisher on " + std::to_string(silent.size()) + " topics: " + silent[0]);
+    } else if (!overlaps.empty()) {
+      s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "regions overlap: " + overlaps[0]);
     } else if (refused > 0) {
       s.summary(diagnostic_msgs::DiagnosticStatus::WARN, "layers refused: " + refusals.last);
     } else if (!site.outside.empty()) {
@@ -211,9 +232,15 @@ int main(int argc, char** argv) {
     s.add("topics without a publisher", silent.size());
     s.add("vehicles outside every region", site.outside.size());
     std::string names;
-    for (const auto& v : site.outside) names += (names.empty() ? "" : " ") + v.vehicle;
+    for (const auto& v : site.outside) {
+      names += (names.empty() ? "" : " ") + v.vehicle + (v.silent ? " (silent)" : "");
+    }
     s.add("outside every region", names);
     s.add("scans mapped by no shard (at most)", site.scans_mapped_by_none_max);
+    std::uint64_t restarts = 0;
+    for (std::size_t i = 0; i < shards.size(); ++i) restarts += lives.restarts(i);
+    s.add("shard restarts", restarts);
+    s.add("overlapping regions", overlaps.size());
   });
   ros::WallTimer diag_timer = nh.createWallTimer(
       ros::WallDuration(1.0), [&](const ros::WallTimerEvent&) { updater.update(); });

@@ -5,10 +5,19 @@
 #include <nav_msgs/OccupancyGrid.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "wavog_mapping/ros/conversions.h"
 
 namespace wavog_fleet {
+
+wavog::CellBox windowCells(const wavog::WaveletMap& map, double x, double y, double half_width) {
+  const wavog::CellBox centre = map.boxAround(x, y, x, y, 0);  // the cell holding (x, y)
+  if (centre.empty() || !(half_width >= 0.0)) return wavog::CellBox{};
+  const std::int64_t k = std::llround(half_width / map.resolution());
+  return wavog::CellBox{centre.min_x - k, centre.min_y - k, centre.min_x + k + 1,
+                        centre.min_y + k + 1};
+}
 
 VehicleWindows::VehicleWindows(ros::NodeHandle nh, const std::vector<std::string>& vehicles,
                                double half_width)
@@ -31,8 +40,7 @@ std::vector<VehicleWindows::Window> VehicleWindows::readLocked(const wavog::Wave
     double x = 0.0, y = 0.0;
     if (v.map_pub.getNumSubscribers() == 0 && v.update_pub.getNumSubscribers() == 0) continue;
     if (!position(i, &x, &y)) continue;
-    const wavog::CellBox box =
-        map.boxAround(x - half_width_, y - half_width_, x + half_width_, y + half_width_, 0);
+    const wavog::CellBox box = windowCells(map, x, y, half_width_);
     if (box.empty() || !wavog::readoutFits(box)) continue;  // fleet_window is checked at start
     Window w;
     w.pub = v.map_pub;

@@ -1,6 +1,7 @@
 // VehicleWindows: the fleet map back to each vehicle (issue 36). Per vehicle of fleet_vehicles,
 // the finest layer of the fleet node's map in a square of half-width fleet_window (m) around the
-// sensor position of the vehicle's latest integrated scan, on <ns>/fleet_map (OccupancyGrid,
+// sensor position of the vehicle's latest integrated scan (windowCells: always the same number of
+// cells), on <ns>/fleet_map (OccupancyGrid,
 // latched; at each full publication) and the changed part of it on <ns>/fleet_map_updates
 // (OccupancyGridUpdate; at update_rate), so that a vehicle's planner sees what the others saw
 // around it. Nothing is read or sent for a vehicle without subscribers or without a scan yet.
@@ -17,6 +18,12 @@
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog_fleet {
+
+/// The window of half-width `half_width` (m) around (x, y): the cell holding (x, y) and
+/// round(half_width / resolution) cells on each side, so 2 round(half_width / resolution) + 1
+/// cells square wherever (x, y) falls in its cell (issue 42: rounding each edge on its own gave
+/// 160, 161 or 162 cells for 161). Empty when (x, y) is not a number.
+wavog::CellBox windowCells(const wavog::WaveletMap& map, double x, double y, double half_width);
 
 class VehicleWindows {
  public:
