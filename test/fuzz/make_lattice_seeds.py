@@ -148,7 +148,16 @@ CASES = {
     "lattice_centre_few_beams": dict(resolution=0.05, policy="clamp", block_levels=5, scans=[
         scan(-0.33, 0.71, 5.5, fan(4, 1.0, 0.3, 1.2, 10), 1, 1),
         scan(0.02, 0.02, -3.1, fan(1, 3.0, 2 * PI, 2.0, 11), 1, 1),
-        scan(0.66, -0.66, 2.36, fan(2, -0.01, 0.02, 0.9, 12), 1, 1)]),
+        scan(0.66, -0.66, 2.36, fan(2, -0.013, 0.02, 0.9, 12), 1, 1)]),
+    # Narrow fans from cell centres that hold sensor bearing 0 but not -theta (the bearing the
+    # reference gives the sensor's own cell): before the fix that cell was E, the reference's U.
+    "lattice_centre_narrow_fans": dict(resolution=0.1, policy="forget", block_levels=3, scans=[
+        scan(0.41, -0.27, 1.6, fan(24, -0.6, 0.05, 2.0, 13), 1, 1),
+        scan(-0.52, 0.33, 3.1, fan(90, -PI / 2 + 0.01, PI / 90, 2.5, 14), 1, 1),
+        scan(0.07, 0.88, -2.4, fan(40, 0.7, -0.035, 1.8, 15), 1, 1)]),
+    "lattice_centre_narrow_max": dict(resolution=0.05, policy="max", block_levels=4, scans=[
+        scan(-0.77, -0.12, -1.6, fan(60, -0.25, 0.01, 2.2, 16), 1, 1),
+        scan(0.44, 0.61, 0.8, fan(100, -1.0, 0.012, 1.4, 17), 1, 2)]),
 }
 
 
