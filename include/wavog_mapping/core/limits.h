@@ -42,8 +42,25 @@ constexpr double kMaxRangeBlocks = 256.0;
 /// beams reach 23,237 cells, 1,081 beams 7,760, 4,096 beams 2,048; 1,160 m / 388 m / 102 m at
 /// 5 cm).
 constexpr double kMaxScanBeamCells = 8388608.0;
-/// The hard range limit (m) of a scan of `beams` beams on `grid`: the smallest of the three above.
+/// The hard range limit (m) of a scan of `beams` beams on `grid` with an occupied band of one
+/// cell: the smallest of the three above.
 double hardRangeLimit(const GridParams& grid, std::size_t beams);
+/// Widest occupied band, in cells (band_width / resolution): 512. A wider one is refused by
+/// MapParams::validate(), naming band_width and resolution (a band of 10 m is allowed from a
+/// resolution of 1.96 cm). Its cells alone (pi B^2 for a whole turn, below) then take at most a
+/// tenth of kMaxScanBeamCells.
+constexpr double kMaxBandCells = 512.0;
+/// The hard range limit (m) of a scan of `beams` beams, `angle_increment` apart, under `params`:
+/// hardRangeLimit(grid, beams), and a wider occupied band of B = band_width / resolution cells
+/// counted against the same budget. The walk visits every cell of a hit's band one by one (no
+/// square of O cells is updated whole), about as many nodes per cell as per beam-cell; the bands
+/// of returns up to L cells hold at most fov (B - 1) (L + B / 2) cells beyond the one-cell band
+/// (fov = beams |angle_increment| <= 2 pi), so L is capped at
+/// (kMaxScanBeamCells - fov (B - 1) B / 2) / (beams + fov (B - 1)): one scan's tree work stays
+/// near 1.4e7 nodes for every band_width (at 1.01 mm, band_width 0.3 m, 8 beams over a turn
+/// returning at the limit: L = 4.4 m and 1.36e7 nodes; without the cap 66 m and 2.06e8 nodes).
+/// A one-cell band (band_width <= resolution) leaves hardRangeLimit(grid, beams).
+double hardRangeLimit(const MapParams& params, std::size_t beams, double angle_increment);
 
 /// Largest |angle_min| (rad) a scan may have; beyond it, refused as kBadGeometry (bearings stay
 /// exact to 1e-14 rad below it; drivers send values in [-2 pi, 2 pi]).
