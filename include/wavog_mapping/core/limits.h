@@ -79,7 +79,9 @@ constexpr std::size_t kScratchKeepBeams = std::size_t{1} << 16;
 /// details per level, 12 levels) stays under 4e31, so the details an update writes back (doubles
 /// since issue 37, floats in files before version 6; at most the largest |value| of the cells they
 /// combine) stay far under FLT_MAX: every update keeps the map finite, and a map holds nothing an
-/// older build could not. The updates themselves stay far below it (|odd| <= 50 per scan).
+/// older build could not. The updates themselves stay far below it (|odd| <= 50 per scan); the
+/// details and averages they write are kept within it (saturated, update/map_slot.h keepStored)
+/// also where a loaded file's cells lie beyond it, so that every map saves a file that loads.
 constexpr double kMaxStoredLogOdds = 1e30;
 
 /// Largest read-out, in raster cells (2^26: e.g. 8192 x 8192, 320 MiB of raster); exportScale
