@@ -197,8 +197,9 @@ std::string coreRefusal(const wavog::IntegrateStats& st, const wavog::ScanView& 
         << " invalid (NaN, -inf, <= 0 or below range_min " << view.range_min << " m), "
         << st.beams_no_return << " no return (+inf or >= range_max " << view.range_max
         << " m), of which " << st.beams_beyond_limit << " beyond the hard range limit of "
-        << wavog::hardRangeLimit(params.grid, view.count) << " m (limits.h, for " << view.count
-        << " beams at resolution " << params.grid.resolution << " m)";
+        << wavog::hardRangeLimit(params, view.count, view.angle_increment) << " m (limits.h, for "
+        << view.count << " beams at resolution " << params.grid.resolution << " m and band_width "
+        << params.sensor.band_width << " m)";
       break;
     case wavog::ScanStatus::kOutOfExtent:
       s << "the laser at (" << pose.x << ", " << pose.y << ") m plus its reach leaves the "

@@ -88,7 +88,7 @@ bool ReferenceClassifier::prepare(const wavog::MapParams& p, const wavog::Pose2&
   seam_ = 0.5 * (amin_ + amax) - kPi;
   res_ = p.grid.resolution;
   // The hard range limit (limits.h) caps the range limit and the no-return clearing distance.
-  const double hard = wavog::hardRangeLimit(p.grid, scan.count);
+  const double hard = wavog::hardRangeLimit(p, scan.count, scan.angle_increment);
   const double sensor_max = std::min(
       p.sensor.max_range > 0 ? std::min(p.sensor.max_range, scan.range_max) : scan.range_max, hard);
   const double clear = std::min(p.sensor.no_return_clear, hard);

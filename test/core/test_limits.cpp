@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <future>
 #include <limits>
@@ -31,6 +33,9 @@ using wavog::ScanView;
 using wavog::WaveletMap;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Nearly the widest band the parameters accept at `res` (kMaxBandCells cells).
+double widestBandAt(double res) { return (wavog::kMaxBandCells - 0.5) * res; }
 
 MapParams params(double res, int levels) {
   MapParams p = MapParams::defaultsFor(wavog::PolicyType::kClamp);
@@ -315,6 +320,53 @@ TEST(Limits, WorkOfTheCostliestScanIsBounded) {
   EXPECT_EQ(st.beams_hit, beams);
   EXPECT_GT(st.nodes_visited, 1000000u);  // the case is costly indeed
   EXPECT_LE(static_cast<double>(st.nodes_visited), 4.0 * wavog::kMaxScanBeamCells);
+}
+
+// Issue 42, item 4: a wide occupied band is walked cell by cell, so its cells count against the
+// same budget (hardRangeLimit(params, beams, increment)). At 1.01 mm with every beam returning just
+// inside the hard limit, a band of 0.3 m took 1.85e8 nodes per scan and one of 10 m 1.83e9; now
+// every scan stays within the bound of a one-cell band, and a band of more than kMaxBandCells
+// cells is refused by the parameters, naming band_width and resolution.
+TEST(Limits, WideBandKeepsTheWorkOfAScanBounded) {
+  const double res = 1.01e-3, pi = 3.14159265358979323846;
+  struct Fan {
+    std::size_t beams;
+    double fov;
+  };
+  const Fan fans[] = {{361, pi}, {1081, 1.5 * pi}, {3600, 2 * pi}, {8, 2 * pi}};
+  std::uint64_t worst_band0 = 0;
+  for (const double band : {0.0, 0.3, widestBandAt(res)}) {
+    MapParams p = params(res, 9);
+    p.sensor.band_width = band;
+    ASSERT_TRUE(p.validate().empty()) << band;
+    for (const Fan& f : fans) {
+      const double inc = f.fov / static_cast<double>(f.beams);
+      const double hard = wavog::hardRangeLimit(p, f.beams, inc);
+      EXPECT_LE(hard, wavog::hardRangeLimit(p.grid, f.beams));
+      if (band == 0.0) EXPECT_EQ(hard, wavog::hardRangeLimit(p.grid, f.beams));
+      const std::vector<float> ranges(f.beams, static_cast<float>(0.999 * hard));
+      WaveletMap map(p);
+      const ScanView scan{ranges.data(), ranges.size(), -0.5 * f.fov, inc, 0.0, kInf};
+      const IntegrateStats st = map.integrate(Pose2{0.3, -0.2, 0.1}, scan);
+      ASSERT_EQ(st.status, ScanStatus::kOk);
+      EXPECT_EQ(st.beams_hit, f.beams) << band;  // every return inside the limit maps
+      std::printf("band_width %.4g m, %zu beams over %.3g rad: hard limit %.4g m, %llu nodes\n",
+                  band, f.beams, f.fov, hard, static_cast<unsigned long long>(st.nodes_visited));
+      if (band == 0.0) worst_band0 = std::max(worst_band0, st.nodes_visited);
+      EXPECT_LE(static_cast<double>(st.nodes_visited), 2.0 * wavog::kMaxScanBeamCells)
+          << "band_width " << band << ", " << f.beams << " beams";
+      EXPECT_EQ(map.stats().nodes_visited_last, st.nodes_visited);
+    }
+  }
+  EXPECT_GT(worst_band0, 1000000u);  // the scans are costly indeed
+  // The allowed maximum of band_width, 10 m, is refused at this resolution, naming both.
+  MapParams wide = params(res, 9);
+  wide.sensor.band_width = 10.0;
+  const auto errors = wide.validate();
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("band_width"), std::string::npos) << errors[0];
+  EXPECT_NE(errors[0].find("resolution"), std::string::npos) << errors[0];
+  EXPECT_THROW(WaveletMap{wide}, std::invalid_argument);
 }
 
 // Scratch buffers grown by one absurd scan are released; ordinary ones are kept for reuse.

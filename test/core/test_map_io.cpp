@@ -6,16 +6,19 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <iterator>
 
+#include "map_access.h"
 #include "test_support.h"
 
 namespace wavog_test {
@@ -353,6 +356,84 @@ TEST(MapIo, LogOddsTheUpdateCannotCarryAreRefused) {
     EXPECT_NO_THROW(again.load(path));
   }
   std::remove(path.c_str());
+}
+
+// Issue 42, item 3: a file whose block averages and details all sit at the bound loads, and holds
+// cells far beyond it (an average plus up to three details per level). The details an update
+// derived from such cells went beyond the bound (-1.1e30 after one scan), so the map saved a file
+// it would not load, under 5 of the 6 policies. Every update keeps its coefficients within the
+// bound now: whatever the map saves loads, and every value stays finite.
+TEST(MapIo, AMapLoadedAtTheBoundSavesFilesThatLoad) {
+  const double bound = wavog::kMaxStoredLogOdds;
+  const std::string at_bound = tempPath("at_bound.wavog"), saved = tempPath("saved_again.wavog");
+  std::size_t nodes = 0;
+  {
+    WaveletMap source(params());
+    fill(&source, 42);
+    auto& im = wavog::MapAccess::impl(source);
+    // Signs alternating by level and child: some cells add every detail on their path.
+    std::function<void(wavog::detail::Node&, int)> set = [&](wavog::detail::Node& n, int l) {
+      ++nodes;
+      const double sign = l % 2 == 0 ? 1.0 : -1.0;
+      n.d[0] = sign * bound;
+      n.d[1] = -sign * bound;
+      n.d[2] = sign * bound;
+      if (l <= 1) return;
+      for (int q = 0; q < 4; ++q) {
+        if (im.hasChild(n, q)) set(im.child(n, q), l - 1);
+      }
+    };
+    std::size_t i = 0;
+    for (auto& kv : im.blocks) {
+      kv.second.s = (i++ % 2 == 0) ? bound : -bound;
+      if (kv.second.has_root) set(kv.second.root, im.levels);
+    }
+    source.save(at_bound);
+  }
+  ASSERT_GT(nodes, 1000u);
+  for (const wavog::PolicyType type : everyPolicyType()) {
+    SCOPED_TRACE(wavog::toString(type));
+    MapParams p = MapParams::defaultsFor(type);
+    p.grid.resolution = params().grid.resolution;
+    p.grid.block_levels = params().grid.block_levels;
+    WaveletMap map(p);
+    ASSERT_NO_THROW(map.load(at_bound));
+    wavog::CellBox box;
+    ASSERT_TRUE(map.bounds(0, &box));
+    const auto largest = [&box](const WaveletMap& m) {
+      const auto r = m.exportScale(0, box, wavog::Aggregation::kMean);
+      double most = 0.0;
+      for (float v : r.log_odds) {
+        EXPECT_TRUE(std::isfinite(v));
+        most = std::max(most, std::fabs(static_cast<double>(v)));
+      }
+      return most;
+    };
+    EXPECT_GT(largest(map), 4.0 * bound);  // the file holds cells far beyond the bound
+    RandomScans scans(7, 12.0);
+    for (int k = 0; k < 3; ++k) {
+      const auto s = scans.next();
+      map.integrate(s.pose, s.view());
+      map.save(saved);
+      WaveletMap again(p);
+      std::string why;
+      try {
+        again.load(saved);
+      } catch (const MapIoError& e) {
+        why = e.what();
+      }
+      EXPECT_EQ(why, "") << "after scan " << k;
+      if (!why.empty()) break;
+      EXPECT_LT(largest(again), 40.0 * bound);
+    }
+    // Clearing a box beside such cells writes details too.
+    map.clearBox(-3.0, -3.0, 1.0, 1.0);
+    map.save(saved);
+    WaveletMap cleared(p);
+    EXPECT_NO_THROW(cleared.load(saved));
+  }
+  std::remove(at_bound.c_str());
+  std::remove(saved.c_str());
 }
 
 // Issue 28, item 5 (core side): a caller configured without reflection or NDT can tell that a

@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/params.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
@@ -55,6 +56,27 @@ TEST(Params, EachRuleNamesItsParameter) {
     EXPECT_NE(errors[0].find(rule.param), std::string::npos) << errors[0];
     EXPECT_THROW(wavog::WaveletMap{p}, std::invalid_argument) << rule.param;
   }
+}
+
+// Issue 42, item 4: a band of more than kMaxBandCells cells is refused, naming band_width and
+// resolution (its cells are walked one by one); at the limit it is accepted.
+TEST(Params, BandWiderThanItsCellLimitIsRefused) {
+  for (const double res : {1.01e-3, 0.01, 0.0195}) {
+    MapParams p;
+    p.grid.resolution = res;
+    p.sensor.band_width = 10.0;  // the largest band_width allowed at any resolution
+    const auto errors = p.validate();
+    ASSERT_EQ(errors.size(), 1u) << res;
+    EXPECT_NE(errors[0].find("band_width"), std::string::npos) << errors[0];
+    EXPECT_NE(errors[0].find("resolution"), std::string::npos) << errors[0];
+    EXPECT_THROW(wavog::WaveletMap{p}, std::invalid_argument) << res;
+    p.sensor.band_width = 0.999 * wavog::kMaxBandCells * res;
+    EXPECT_TRUE(p.validate().empty()) << res;
+  }
+  MapParams coarse;
+  coarse.grid.resolution = 0.02;  // 500 cells of band
+  coarse.sensor.band_width = 10.0;
+  EXPECT_TRUE(coarse.validate().empty());
 }
 
 TEST(Params, EveryViolationIsListed) {

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -111,39 +112,47 @@ class Walk {
   Seen* seen_;
 };
 
+constexpr int kWalkLevels = 5;
+
+// One scan: the classifier against the reference on every square of side 2^kWalkLevels within
+// its reach (plus one square of margin), down to every cell. False when both refuse it.
+bool checkScan(const wavog::MapParams& p, const OwnedScan& s, ScanClassifier* cls,
+               ReferenceClassifier* ref, Seen* seen) {
+  const std::int64_t size = std::int64_t{1} << kWalkLevels;
+  wavog::IntegrateStats st;
+  const wavog::ScanStatus status = cls->prepare(p, s.pose, s.view(), &st);
+  const bool ref_ok = ref->prepare(p, s.pose, s.view());
+  EXPECT_EQ(status == wavog::ScanStatus::kOk, ref_ok);
+  if (!ref_ok || status != wavog::ScanStatus::kOk) return false;
+  EXPECT_EQ(st.beams_hit + st.beams_no_return + st.beams_invalid, s.ranges.size());
+  const double reach = ref->reach() + size * p.grid.resolution;
+  const auto lo_x =
+      static_cast<std::int64_t>(std::floor((s.pose.x - reach) / p.grid.resolution)) / size - 1;
+  const auto hi_x =
+      static_cast<std::int64_t>(std::floor((s.pose.x + reach) / p.grid.resolution)) / size + 1;
+  const auto lo_y =
+      static_cast<std::int64_t>(std::floor((s.pose.y - reach) / p.grid.resolution)) / size - 1;
+  const auto hi_y =
+      static_cast<std::int64_t>(std::floor((s.pose.y + reach) / p.grid.resolution)) / size + 1;
+  Walk walk(*cls, *ref, seen);
+  for (std::int64_t by = lo_y; by <= hi_y; ++by) {
+    for (std::int64_t bx = lo_x; bx <= hi_x; ++bx) {
+      walk.square(kWalkLevels, bx * size, by * size,
+                  cls->classifySquare(kWalkLevels, bx * size, by * size));
+      if (::testing::Test::HasFailure()) return true;
+    }
+  }
+  return true;
+}
+
 void checkScans(const wavog::MapParams& p, std::uint32_t seed, int count, Seen* seen) {
   const double half = 8.0;
   RandomScans scans(seed, half);
   ScanClassifier cls;
   ReferenceClassifier ref;
-  constexpr int kLevels = 5;
-  const std::int64_t size = std::int64_t{1} << kLevels;
   for (int i = 0; i < count; ++i) {
-    const OwnedScan s = scans.next();
-    wavog::IntegrateStats st;
-    const wavog::ScanStatus status = cls.prepare(p, s.pose, s.view(), &st);
-    const bool ref_ok = ref.prepare(p, s.pose, s.view());
-    ASSERT_EQ(status == wavog::ScanStatus::kOk, ref_ok) << "scan " << i;
-    if (!ref_ok) continue;
-    ASSERT_EQ(st.beams_hit + st.beams_no_return + st.beams_invalid, s.ranges.size());
-    // Every square of side 2^kLevels within the scan's reach (plus one square of margin).
-    const double reach = ref.reach() + size * p.grid.resolution;
-    const auto lo_x =
-        static_cast<std::int64_t>(std::floor((s.pose.x - reach) / p.grid.resolution)) / size - 1;
-    const auto hi_x =
-        static_cast<std::int64_t>(std::floor((s.pose.x + reach) / p.grid.resolution)) / size + 1;
-    const auto lo_y =
-        static_cast<std::int64_t>(std::floor((s.pose.y - reach) / p.grid.resolution)) / size - 1;
-    const auto hi_y =
-        static_cast<std::int64_t>(std::floor((s.pose.y + reach) / p.grid.resolution)) / size + 1;
-    Walk walk(cls, ref, seen);
-    for (std::int64_t by = lo_y; by <= hi_y; ++by) {
-      for (std::int64_t bx = lo_x; bx <= hi_x; ++bx) {
-        walk.square(kLevels, bx * size, by * size,
-                    cls.classifySquare(kLevels, bx * size, by * size));
-        if (::testing::Test::HasFailure()) return;
-      }
-    }
+    checkScan(p, scans.next(), &cls, &ref, seen);
+    ASSERT_FALSE(::testing::Test::HasFailure()) << "scan " << i;
   }
 }
 
@@ -176,6 +185,162 @@ TEST(ScanClassifier, ClearingNoReturnsWideBandAndMaxRange) {
   checkScans(p, 4242u, 120, &seen);
   expectEveryClassSeen(seen, "clearing");
   EXPECT_GT(seen.squares[static_cast<std::size_t>(CellClass::kFreeOrUnknown)], 0u);
+}
+
+// Scans taken from the lattice of cells (issue 42): the sensor on a cell centre (its own cell's
+// offset is (0, 0), whose bearing the reference takes as atan2(0, 0) = 0 in the map frame), on a
+// cell edge or a corner; headings on multiples of pi / 4 (also a turn off) and random; fans of a
+// few wide beams, fans with a sector boundary along an axis or a diagonal of the lattice (through
+// cell centres), and fans with a beam along one. Simulated and quantised poses sit there.
+class LatticeScans {
+ public:
+  LatticeScans(std::uint32_t seed, double res) : rng_(seed), res_(res) {}
+
+  OwnedScan next() {
+    OwnedScan s;
+    const int kind = count_++ % 4;  // centre / centre x, edge y / edge x, centre y / corner
+    const auto at = [&](bool centre) {
+      const double i = static_cast<double>(index(rng_));
+      return centre ? (i + 0.5) * res_ : i * res_;  // as the classifier computes a cell centre
+    };
+    s.pose.x = at(kind == 0 || kind == 1);
+    s.pose.y = at(kind == 0 || kind == 2);
+    const double eighth = static_cast<double>(eighths(rng_)) * kPi / 4;
+    const double pick = unit(rng_);
+    s.pose.theta = pick < 0.5    ? eighth
+                   : pick < 0.7  ? eighth + (unit(rng_) < 0.5 ? -2 : 2) * kPi
+                   : pick < 0.85 ? eighth + 0.0086
+                                 : (unit(rng_) - 0.5) * 2 * kPi;
+    const double along = static_cast<double>(eighths(rng_)) * kPi / 4;  // sensor frame
+    const int fan = static_cast<int>(unit(rng_) * 3);
+    int n;
+    if (fan == 0) {  // a few wide beams anywhere
+      n = 1 + static_cast<int>(unit(rng_) * 4);
+      const double steps[] = {0.01, 0.02, 0.1, 0.3, 1.0, 2 * kPi / n};
+      s.angle_increment = steps[static_cast<int>(unit(rng_) * 6)];
+      s.angle_min = (unit(rng_) - 0.5) * 2 * kPi;
+    } else {  // a boundary (fan 1) or a beam (fan 2) along a lattice direction
+      n = 8 + static_cast<int>(unit(rng_) * 400);
+      const double fovs[] = {2 * kPi, 1.5 * kPi, kPi, 0.5 * kPi};
+      s.angle_increment = fovs[static_cast<int>(unit(rng_) * 4)] / n;
+      const double k = std::floor(unit(rng_) * n);
+      s.angle_min = along - (k + (fan == 1 ? 0.5 : 0.0)) * s.angle_increment;
+    }
+    if (unit(rng_) < 0.3) {  // the same beams, listed clockwise
+      s.angle_min += (n - 1) * s.angle_increment;
+      s.angle_increment = -s.angle_increment;
+    }
+    s.range_min = 0.02;
+    s.range_max = 3.0;
+    s.ranges.resize(static_cast<std::size_t>(n));
+    for (auto& z : s.ranges) {
+      const double r = unit(rng_);
+      z = r < 0.05   ? std::numeric_limits<float>::quiet_NaN()
+          : r < 0.1  ? std::numeric_limits<float>::infinity()
+          : r < 0.15 ? 0.01f
+                     : static_cast<float>(0.05 + 2.9 * unit(rng_));
+    }
+    // Half of the fans of one beam: the issue's 0.8 m return.
+    if (n == 1 && unit(rng_) < 0.5) s.ranges[0] = 0.8f;
+    return s;
+  }
+
+ private:
+  static constexpr double kPi = 3.14159265358979323846;
+  std::mt19937 rng_;
+  double res_;
+  int count_ = 0;
+  std::uniform_int_distribution<int> index{-40, 40};
+  std::uniform_int_distribution<int> eighths{-8, 8};
+  std::uniform_real_distribution<double> unit{0.0, 1.0};
+};
+
+// Issue 42: the sensor exactly on a cell centre, theta pi / 4, one beam at -0.0086 rad whose
+// sector holds sensor bearing 0 but not the reference's -pi / 4 for the offset (0, 0). The core
+// wrote the sensor's own cell E (-0.4) where the reference leaves it U.
+TEST(ScanClassifier, SensorOnACellCentreKeepsTheReferencesClassOfItsCell) {
+  wavog::MapParams p = wavog::MapParams::defaultsFor(wavog::PolicyType::kClamp);
+  p.grid.resolution = 0.05;
+  const float range = 0.8f;
+  const wavog::Pose2 pose{0.275, -0.275, 3.14159265358979323846 / 4};
+  ASSERT_EQ((5 + 0.5) * p.grid.resolution, pose.x);  // exactly the centre of cell (5, -6)
+  ASSERT_EQ((-6 + 0.5) * p.grid.resolution, pose.y);
+  for (const double inc : {0.1, 0.5, 1.0, -0.1}) {
+    const wavog::ScanView view{&range, 1, -0.0086, inc, 0.0, 10.0};
+    ReferenceClassifier ref;
+    ASSERT_TRUE(ref.prepare(p, pose, view));
+    ASSERT_EQ(ref.cellClass(5, -6), CellClass::kUnknown) << "increment " << inc;
+    ScanClassifier cls;
+    Seen seen;
+    ASSERT_TRUE(checkScan(p, OwnedScan{pose, {range}, -0.0086, inc, 0.0, 10.0}, &cls, &ref, &seen))
+        << "increment " << inc;
+    ASSERT_FALSE(::testing::Test::HasFailure()) << "increment " << inc;
+    // The map: the sensor's cell stays unobserved at the prior, the reference's cells agree.
+    wavog::WaveletMap map(p);
+    DenseReference dense(p, wavog::CellBox{-40, -40, 40, 40});
+    map.integrate(pose, view);
+    dense.integrate(pose, view);
+    EXPECT_FALSE(map.isObserved({5, -6})) << "increment " << inc;
+    EXPECT_EQ(map.value({5, -6}), dense.value(5, -6)) << "increment " << inc;
+    const Comparison c = compare(map, dense);
+    EXPECT_EQ(c.knowledge_mismatches, 0u) << "increment " << inc;
+    EXPECT_LE(c.max_rel_error, 1e-4) << "increment " << inc;
+  }
+}
+
+// Many such poses, every cell of every square within reach (classifier alone), at three
+// resolutions (0.0625: cell centres and edges exact in binary) and with a wide band and clearing
+// no-returns.
+TEST(ScanClassifier, LatticePosesMatchTheCellByCellReference) {
+  std::size_t sensor_on_centre = 0;
+  for (const double res : {0.05, 0.1, 0.0625}) {
+    for (const bool wide : {false, true}) {
+      wavog::MapParams p;
+      p.grid.resolution = res;
+      if (wide) {
+        p.sensor.band_width = 0.3;
+        p.sensor.no_return_clear = 2.0;
+      }
+      LatticeScans scans(wide ? 4201u : 42u, res);
+      ScanClassifier cls;
+      ReferenceClassifier ref;
+      Seen seen;
+      for (int i = 0; i < 200; ++i) {
+        const OwnedScan s = scans.next();
+        if (!checkScan(p, s, &cls, &ref, &seen)) continue;
+        ASSERT_FALSE(::testing::Test::HasFailure())
+            << "resolution " << res << " scan " << i << " pose (" << s.pose.x << ", " << s.pose.y
+            << ", " << s.pose.theta << ") angle_min " << s.angle_min << " increment "
+            << s.angle_increment << ", " << s.ranges.size() << " beams";
+        if (i % 4 == 0) ++sensor_on_centre;
+      }
+      expectEveryClassSeen(seen, "lattice poses");
+    }
+  }
+  EXPECT_GT(sensor_on_centre, 250u);  // of 300 scans from a cell centre
+}
+
+// The same scans integrated into maps against the dense reference (every policy's path through
+// the walk: single-beam squares, 4 x 4 and 8 x 8 groups, leaf parents).
+TEST(ScanClassifier, LatticePosesGiveTheReferencesMap) {
+  for (const double res : {0.05, 0.0625}) {
+    wavog::MapParams p = wavog::MapParams::defaultsFor(wavog::PolicyType::kClamp);
+    p.grid.resolution = res;
+    p.grid.block_levels = 4;
+    const auto half = static_cast<std::int64_t>(std::ceil(5.5 / res));
+    wavog::WaveletMap map(p);
+    DenseReference dense(p, wavog::CellBox{-half, -half, half, half});
+    LatticeScans scans(7u, res);
+    for (int i = 0; i < 120; ++i) {
+      const OwnedScan s = scans.next();
+      map.integrate(s.pose, s.view());
+      dense.integrate(s.pose, s.view());
+      const Comparison c = compare(map, dense);
+      ASSERT_EQ(c.knowledge_mismatches, 0u) << "resolution " << res << " scan " << i;
+      ASSERT_LE(c.max_rel_error, 1e-4) << "resolution " << res << " scan " << i << " cell ("
+                                       << c.worst_x << ", " << c.worst_y << ")";
+    }
+  }
 }
 
 TEST(ScanClassifier, RefusedScansAgreeWithTheReference) {

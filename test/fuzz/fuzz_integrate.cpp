@@ -11,7 +11,9 @@
 //  - oracle: a small map (poses within 1 m, range limits up to 3 m, tau = 0) integrated next to
 //    the dense cell-by-cell reference (test/core/dense_reference.h); every cell, every coarse
 //    scale up to 3, and clearBox (cleared cells back to the prior, the others unchanged) must
-//    agree with it;
+//    agree with it; the last bytes may put each scan's sensor on a cell centre, corner or edge,
+//    its heading on a multiple of pi / 4 and a sector boundary along it (placeOnLattice; the
+//    seeds lattice_* of corpus/fuzz_integrate, made by make_lattice_seeds.py);
 //  - hostile: any value anywhere; the contract is only "no crash, no undefined behaviour, bounded
 //    work, a consistent read-out and an exact save / load round trip".
 #include <algorithm>
@@ -162,6 +164,33 @@ Scan decodeScan(FuzzedDataProvider* in, bool oracle, double resolution) {
   return s;
 }
 
+// Oracle mode, last (so the bytes of older seeds decode as before, and an input that ends here
+// leaves its scans as they are): per scan, the sensor placed on the lattice of cells (a cell
+// centre, where its own cell's offset is (0, 0), a corner or an edge), the heading on a multiple
+// of pi / 4, and a sector boundary along that heading, through cell centres (issue 42: the
+// lookup by table missed the reference's bearing of the offset (0, 0)). Values the continuous
+// decoding hits with probability 0, which simulated and quantised poses have.
+void placeOnLattice(FuzzedDataProvider* in, double res, Scan* s) {
+  const int place = in->ConsumeIntegralInRange<int>(0, 4);  // 0: as decoded
+  if (place == 0) return;
+  const auto at = [res](double v, bool centre) {
+    // As the classifier computes a cell's centre, (i + 1/2) res, and an edge, i res.
+    return centre ? (std::floor(v / res) + 0.5) * res : std::round(v / res) * res;
+  };
+  s->pose.x = at(s->pose.x, place == 1 || place == 3);  // 1 centre, 2 corner, 3 / 4 edges
+  s->pose.y = at(s->pose.y, place == 1 || place == 4);
+  const int heading = in->ConsumeIntegralInRange<int>(0, 2);
+  if (heading == 0) return;
+  const double eighth = kTwoPi / 8;
+  s->pose.theta = std::round(s->pose.theta / eighth) * eighth;
+  if (heading == 2) {  // the boundary between beams j0 and j0 + 1 at sensor bearing 0
+    const double last = static_cast<double>(s->ranges.size()) - 1.0;
+    const double j0 =
+        std::clamp(std::round(-s->angle_min / s->angle_increment - 0.5), 0.0, std::max(last, 0.0));
+    s->angle_min = -(j0 + 0.5) * s->angle_increment;
+  }
+}
+
 Case decode(const std::uint8_t* data, std::size_t size) {
   FuzzedDataProvider in(data, size);
   Case c;
@@ -180,6 +209,9 @@ Case decode(const std::uint8_t* data, std::size_t size) {
   } else {
     c.clear = {hostileDouble(&in, -lim, lim), hostileDouble(&in, -lim, lim),
                hostileDouble(&in, -lim, lim), hostileDouble(&in, -lim, lim)};
+  }
+  if (c.oracle) {
+    for (auto& s : c.scans) placeOnLattice(&in, c.params.grid.resolution, &s);
   }
   return c;
 }

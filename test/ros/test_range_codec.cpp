@@ -59,7 +59,7 @@ TEST(RangeCodec, ReturnsRoundTripWithinHalfAStep) {
   RangeCodec c;
   ASSERT_TRUE(c.encode(view, params10cm()));
   // 80 m reach: above 65.534 m, so the step widens to reach / 65534 (1.22 mm).
-  const double reach = wavog_fleet::scanReach(params10cm(), 80.0, r.size());
+  const double reach = wavog_fleet::scanReach(params10cm(), 80.0, r.size(), view.angle_increment);
   EXPECT_EQ(reach, 80.0);
   EXPECT_DOUBLE_EQ(c.step(), 80.0 / kMaxHitCode);
   ASSERT_EQ(c.codes().size(), r.size());

@@ -42,8 +42,25 @@ constexpr double kMaxRangeBlocks = 256.0;
 /// beams reach 23,237 cells, 1,081 beams 7,760, 4,096 beams 2,048; 1,160 m / 388 m / 102 m at
 /// 5 cm).
 constexpr double kMaxScanBeamCells = 8388608.0;
-/// The hard range limit (m) of a scan of `beams` beams on `grid`: the smallest of the three above.
+/// The hard range limit (m) of a scan of `beams` beams on `grid` with an occupied band of one
+/// cell: the smallest of the three above.
 double hardRangeLimit(const GridParams& grid, std::size_t beams);
+/// Widest occupied band, in cells (band_width / resolution): 512. A wider one is refused by
+/// MapParams::validate(), naming band_width and resolution (a band of 10 m is allowed from a
+/// resolution of 1.96 cm). Its cells alone (pi B^2 for a whole turn, below) then take at most a
+/// tenth of kMaxScanBeamCells.
+constexpr double kMaxBandCells = 512.0;
+/// The hard range limit (m) of a scan of `beams` beams, `angle_increment` apart, under `params`:
+/// hardRangeLimit(grid, beams), and a wider occupied band of B = band_width / resolution cells
+/// counted against the same budget. The walk visits every cell of a hit's band one by one (no
+/// square of O cells is updated whole), about as many nodes per cell as per beam-cell; the bands
+/// of returns up to L cells hold at most fov (B - 1) (L + B / 2) cells beyond the one-cell band
+/// (fov = beams |angle_increment| <= 2 pi), so L is capped at
+/// (kMaxScanBeamCells - fov (B - 1) B / 2) / (beams + fov (B - 1)): one scan's tree work stays
+/// near 1.4e7 nodes for every band_width (at 1.01 mm, band_width 0.3 m, 8 beams over a turn
+/// returning at the limit: L = 4.4 m and 1.36e7 nodes; without the cap 66 m and 2.06e8 nodes).
+/// A one-cell band (band_width <= resolution) leaves hardRangeLimit(grid, beams).
+double hardRangeLimit(const MapParams& params, std::size_t beams, double angle_increment);
 
 /// Largest |angle_min| (rad) a scan may have; beyond it, refused as kBadGeometry (bearings stay
 /// exact to 1e-14 rad below it; drivers send values in [-2 pi, 2 pi]).
@@ -62,7 +79,9 @@ constexpr std::size_t kScratchKeepBeams = std::size_t{1} << 16;
 /// details per level, 12 levels) stays under 4e31, so the details an update writes back (doubles
 /// since issue 37, floats in files before version 6; at most the largest |value| of the cells they
 /// combine) stay far under FLT_MAX: every update keeps the map finite, and a map holds nothing an
-/// older build could not. The updates themselves stay far below it (|odd| <= 50 per scan).
+/// older build could not. The updates themselves stay far below it (|odd| <= 50 per scan); the
+/// details and averages they write are kept within it (saturated, update/map_slot.h keepStored)
+/// also where a loaded file's cells lie beyond it, so that every map saves a file that loads.
 constexpr double kMaxStoredLogOdds = 1e30;
 
 /// Largest read-out, in raster cells (2^26: e.g. 8192 x 8192, 320 MiB of raster); exportScale

@@ -109,7 +109,7 @@ void PreparedScan::setBoundaries() {
 BeamLimits beamLimits(const MapParams& params, const ScanView& scan) {
   // The hard limit caps range_max (+inf is allowed by REP 117) and no_return_clear, so one scan's
   // reach, and with it the blocks and cells it may touch, is bounded (limits.h).
-  const double hard = hardRangeLimit(params.grid, scan.count);
+  const double hard = hardRangeLimit(params, scan.count, scan.angle_increment);
   const double given = params.sensor.max_range > 0
                            ? std::min(params.sensor.max_range, scan.range_max)
                            : scan.range_max;

@@ -123,7 +123,12 @@ struct PreparedScan {
   double sensorX(double dx, double dy) const { return cos_theta * dx + sin_theta * dy; }
   double sensorY(double dx, double dy) const { return cos_theta * dy - sin_theta * dx; }
   /// The sector of map-frame offset (dx, dy) from the table (n: outside the fan), or kUnsure.
+  /// The offset (0, 0) (the sensor exactly on a cell centre) has no direction: the reference
+  /// takes its bearing as atan2(0, 0) = 0 in the map frame, -theta in the sensor frame, which the
+  /// table (sensor frame, where (0, 0) lands in the bucket of bearing 0) cannot know: kUnsure,
+  /// so that beamOf() decides it as the reference does (issue 42).
   std::int32_t tableSector(double dx, double dy) const {
+    if (dx == 0.0 && dy == 0.0) return SectorTable::kUnsure;
     return sectors.sector(sensorX(dx, dy), sensorY(dx, dy));
   }
   static std::uint64_t cellKey(std::int64_t ix, std::int64_t iy) {

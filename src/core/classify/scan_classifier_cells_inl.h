@@ -107,7 +107,8 @@ inline std::array<CellMasks, 4> ScanClassifier::classify8x8(std::int64_t ix0, st
 /// every cell finds its sector in the pseudo-bearing table (exact, no trigonometry), and only a
 /// cell in a bucket near a boundary (about one in 10-20) tests the boundaries (sectorIn). The
 /// loops over a group's 16 cells are branch-free; the hits of the square's beams are gathered
-/// once, and the columns' and rows' terms are computed once for all groups.
+/// once, and the columns' and rows' terms are computed once for all groups. Such a square
+/// (fewSectors) never holds the sensor, so no cell here has the offset (0, 0) (tableSector).
 template <std::size_t kSide>
 [[gnu::always_inline]] inline void ScanClassifier::classifyGroups(std::int64_t ix0,
                                                                   std::int64_t iy0,

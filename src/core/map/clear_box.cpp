@@ -101,8 +101,9 @@ std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, doubl
     detail::NodeStore store(impl.pool, &b.spare, &impl.nodes, impl.pool.liveCounter());
     detail::RootSlot slot(impl, store, b);
     const double s = b.s;
-    b.s += detail::refineSlot(
+    const double ds = detail::refineSlot(
         slot, slot.node(), [&](Node& m) { return clearNode(impl, store, m, L, x0, y0, s, box); });
+    b.s = detail::keepStored(b.s + ds);
     impl.dropIfEmpty(bx, by);
   }
   return keys.size();

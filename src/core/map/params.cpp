@@ -86,6 +86,18 @@ std::vector<std::string> MapParams::validate() const {
         sensor.odd_emp, "in [-50, 0) log-odds", &v);
   check(finite(sensor.band_width) && sensor.band_width >= 0.0 && sensor.band_width <= 10.0,
         "band_width", sensor.band_width, "in [0, 10] m (0: one cell)", &v);
+  // Only where both are valid on their own (else their own rules name them).
+  if (finite(grid.resolution) && grid.resolution > 0.001 && grid.resolution <= 100.0 &&
+      finite(sensor.band_width) && sensor.band_width <= 10.0 &&
+      sensor.band_width / grid.resolution > kMaxBandCells) {
+    // The band's cells are walked one by one (limits.h): a band this wide at this resolution
+    // would take most of a scan's work budget on its own.
+    std::ostringstream s;
+    s << "band_width (" << sensor.band_width << " m) must be at most " << kMaxBandCells
+      << " cells at resolution (" << grid.resolution
+      << " m), i.e. <= " << kMaxBandCells * grid.resolution << " m (or a coarser resolution)";
+    v.push_back(s.str());
+  }
   check(finite(sensor.max_range) && sensor.max_range >= 0.0, "max_range", sensor.max_range,
         ">= 0 m (0: the scan's range_max)", &v);
   check(finite(sensor.no_return_clear) && sensor.no_return_clear >= 0.0, "no_return_clear",

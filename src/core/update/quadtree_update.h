@@ -64,8 +64,9 @@ class Integrator {
     const double s = b.s;
     if constexpr (kNdt) enterSlot(sp, box);
     if constexpr (kHits) enterCells(0);
-    b.s += updateSlot(slot, box.cls, s,
-                      [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
+    const double ds = updateSlot(
+        slot, box.cls, s, [&](Node& m) { return visitNode(m, box, impl_.levels, ix0, iy0, s); });
+    b.s = keepStored(b.s + ds);
   }
 
   // The walk of blocks split below their roots (split_plan.h), without payloads.
@@ -79,11 +80,12 @@ class Integrator {
     static_assert(!kNdt && !kHits, "the split walk carries no payloads");
     RootSlot slot(impl_, store_, b);
     const double s = b.s;
-    b.s += updateSlotWith(slot, box.cls, s, [&](Node* stored) {
+    const double ds = updateSlotWith(slot, box.cls, s, [&](Node* stored) {
       Node& m = stored != nullptr ? *stored : storeUniform(slot);
       planNode(m, box, impl_.levels, ix0, iy0, s, split, 0, &b, nullptr, 0, -1, plan);
       return 0.0;  // settle() adds the change
     });
+    b.s = keepStored(b.s + ds);
   }
 
   /// Step 2 (any thread): updates part t (node groups from its own spares).
@@ -106,7 +108,7 @@ class Integrator {
       if (t.parent == nullptr) {
         RootSlot slot(impl_, store_, *t.block);
         settleSlot(slot, *t.node);
-        t.block->s += t.ds;
+        t.block->s = keepStored(t.block->s + t.ds);
       } else {
         ChildSlot slot(impl_, store_, *t.parent, t.q);
         settleSlot(slot, *t.node);

@@ -17,8 +17,10 @@ double givenReach(const wavog::MapParams& params, double range_max) {
 
 }  // namespace
 
-double scanReach(const wavog::MapParams& params, double range_max, std::size_t count) {
-  return std::min(givenReach(params, range_max), wavog::hardRangeLimit(params.grid, count));
+double scanReach(const wavog::MapParams& params, double range_max, std::size_t count,
+                 double angle_increment) {
+  return std::min(givenReach(params, range_max),
+                  wavog::hardRangeLimit(params, count, angle_increment));
 }
 
 double rangeStep(double reach, bool beyond) {
@@ -26,7 +28,7 @@ double rangeStep(double reach, bool beyond) {
 }
 
 bool RangeCodec::encode(const wavog::ScanView& view, const wavog::MapParams& params) {
-  const double reach = scanReach(params, view.range_max, view.count);
+  const double reach = scanReach(params, view.range_max, view.count, view.angle_increment);
   const double given = givenReach(params, view.range_max);
   const double step = rangeStep(reach, given > reach);
   const double range_min = view.range_min;

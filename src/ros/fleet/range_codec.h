@@ -35,9 +35,11 @@ constexpr double kRangeStep = 0.001;
 /// the largest resolution, 100 m, over kMaxHitCode: 100.003 m).
 constexpr double kMaxRangeStep = 128.0;
 
-/// The reach (m) of a scan of `count` beams with limit `range_max` on a map of `params`: a reading
-/// at or beyond it is a no return for the core (max_range, range_max, hardRangeLimit()).
-double scanReach(const wavog::MapParams& params, double range_max, std::size_t count);
+/// The reach (m) of a scan of `count` beams `angle_increment` apart with limit `range_max` on a
+/// map of `params`: a reading at or beyond it is a no return for the core (max_range, range_max,
+/// hardRangeLimit()).
+double scanReach(const wavog::MapParams& params, double range_max, std::size_t count,
+                 double angle_increment);
 /// The step (m) for a scan of that reach: kRangeStep, or reach / kMaxHitCode if coarser; with
 /// `beyond` (the core's hard limit lies below range_max) reach / (kMaxHitCode - 1), which leaves
 /// kMaxHitCode for the readings beyond the limit.
