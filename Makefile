@@ -29,6 +29,8 @@ build: deps $(BUILD)/CMakeCache.txt
 	@if [ -s $(BUILD)/real_data_missing.txt ]; then cmake $(BUILD) >$(BUILD)/configure.log \
 	  || { cat $(BUILD)/configure.log; exit 1; }; fi
 	@bash $(ROOT)/scripts/build.sh $(BUILD) $(JOBS) all
+	@# rosrun skips the package's own build/: bin/ (made here, not in git) is where it finds them.
+	@ln -sfn $(BUILD)/devel/lib/wavog_mapping $(ROOT)/bin
 
 ## Every test (core gtests and rostests), built here; ends with "N passed, N failed".
 test: build
