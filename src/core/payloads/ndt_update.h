@@ -44,8 +44,11 @@ class NdtScanPoints {
       p.code =
           mortonCode(static_cast<std::uint32_t>(ix & mask), static_cast<std::uint32_t>(iy & mask));
       p.beam = static_cast<std::uint32_t>(j);
-      p.x = ex - (static_cast<double>(ix) + 0.5) * ps.res;
-      p.y = ey - (static_cast<double>(iy) + 0.5) * ps.res;
+      // In its cell by construction: far from the origin the subtraction's round-off could put
+      // it beyond the half cell by an ulp of the coordinate, moments a file may not hold.
+      const double h = 0.5 * ps.res;
+      p.x = std::clamp(ex - (static_cast<double>(ix) + 0.5) * ps.res, -h, h);
+      p.y = std::clamp(ey - (static_cast<double>(iy) + 0.5) * ps.res, -h, h);
       points_.push_back(p);
     }
     std::sort(points_.begin(), points_.end(), [](const NdtPoint& a, const NdtPoint& b) {
