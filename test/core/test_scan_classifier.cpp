@@ -525,6 +525,16 @@ TEST(ScanNumerics, TileCrossingsAreTheirRule) {
     }
   }
   EXPECT_GT(unsure, 0u);  // wide margins leave cells on neither side
+  // A boundary parallel to the lines (a zero component: step and margin infinite, line 0's
+  // crossing 0 x inf = NaN) leaves every cell of a NaN line on neither side.
+  const double inf = std::numeric_limits<double>::infinity();
+  for (double q0 : {-inf, inf, std::nan("")}) {
+    const wavog::detail::tile::Crossings x = wavog::detail::tile::crossings(q0, inf, inf);
+    EXPECT_EQ(x.low | x.high, 0u) << q0;
+  }
+  const wavog::detail::tile::Crossings nan_line =
+      wavog::detail::tile::crossings(3.5, std::nan(""), 1e-9);
+  EXPECT_EQ(nan_line.low | nan_line.high, 0u);
 }
 
 TEST(ScanNumerics, TileTransposeSwapsRowsAndColumns) {

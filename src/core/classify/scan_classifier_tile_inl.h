@@ -66,11 +66,13 @@ inline Crossings crossings(double q0, double step, double margin) {
     for (int p = 0; p < 2; ++p) {
       const int l = 4 * h + 2 * p;
       const __m128d c = _mm_add_pd(q, _mm_mul_pd(_mm_set_pd(l + 1, l), st));
-      // Cells below: ceil(c - margin) clamped to [0, 8], as 8 - trunc(8 - v).
+      // Cells below: ceil(c - margin) clamped to [0, 8], as 8 - trunc(8 - v). maxpd gives its
+      // second operand when one is NaN (a boundary parallel to the lines: 0 x inf), so a NaN
+      // crossing leaves no cell below and, with the operands swapped, none above.
       const __m128d lo = _mm_min_pd(_mm_max_pd(_mm_sub_pd(c, m), zero), eight);
       nb[p] = _mm_cvttpd_epi32(_mm_sub_pd(eight, lo));
       // The first cell above: floor(c + margin) + 1 clamped to [0, 8], as trunc(v + 1).
-      const __m128d hi = _mm_min_pd(_mm_max_pd(_mm_add_pd(c, m), minus_one), seven);
+      const __m128d hi = _mm_min_pd(_mm_max_pd(minus_one, _mm_add_pd(c, m)), seven);
       na[p] = _mm_cvttpd_epi32(_mm_add_pd(hi, one));
     }
     below[h] = _mm_sub_epi32(_mm_set1_epi32(8), _mm_unpacklo_epi64(nb[0], nb[1]));
@@ -86,6 +88,7 @@ inline Crossings crossings(double q0, double step, double margin) {
   Crossings x{0, 0};
   for (unsigned l = 0; l < 8; ++l) {
     const double c = q0 + static_cast<double>(l) * step;
+    if (std::isnan(c)) continue;  // no cell surely on either side
     const double lo = std::min(std::max(c - margin, 0.0), 8.0);
     const auto below = static_cast<unsigned>(8 - static_cast<std::int32_t>(8.0 - lo));
     const auto above = static_cast<unsigned>(std::min(std::max(c + margin, -1.0), 7.0) + 1.0);
@@ -141,7 +144,7 @@ inline TileMasks ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0
                           std::max(std::fabs(dy[0]), std::fabs(dy[7]))) +
                      1e-14 * (std::fabs(x0 * s_.res) + std::fabs(y0 * s_.res) + std::fabs(s_.px) +
                               std::fabs(s_.py) + 16.0 * s_.res);
-    const double inv_res = 1.0 / s_.res;
+    const double inv_res = 1.0 / s_.res, t_cells = t * inv_res;
     // Boundary k: past_k, then sector k - 1's sure cells are past k - 1 and not past k.
     std::array<std::uint64_t, kFewSectors + 1> past;
     std::uint64_t unsure = 0;
@@ -151,9 +154,9 @@ inline TileMasks ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0
       // Rows: cross = bx (v0 + line res) - by (u0 + q res); columns: by and bx swap roles and
       // the product changes sign.
       const double a = rows ? s_.bnd_y[k] : s_.bnd_x[k], b = rows ? s_.bnd_x[k] : s_.bnd_y[k];
-      const double step = b / a;
+      const double inv_a = 1.0 / a, step = b * inv_a;
       const tile::Crossings x =
-          tile::crossings((v0 * step - u0) * inv_res, step, t * inv_res / std::fabs(a));
+          tile::crossings((v0 * step - u0) * inv_res, step, t_cells * std::fabs(inv_a));
       // Below the crossing the product has a's sign (rows), or the opposite (columns).
       const bool low_past = (a > 0) == rows;
       past[static_cast<std::size_t>(i)] = low_past ? x.low : x.high;
