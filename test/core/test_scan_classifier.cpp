@@ -486,3 +486,66 @@ TEST(ScanNumerics, QuotientBucketsAreTheScalarQuotient) {
     }
   }
 }
+
+// A tile's crossings (SSE2 where built with it) follow their rule cell by cell: cell p of line l
+// is below when p < c - margin and above when p > c + margin, c = q0 + l step, never wrongly, and
+// exactly unless p lies within 1e-12 of c -+ margin (where rounding may leave it on neither side,
+// to the per-cell path); including crossings just off an integer, beyond either end, wide margins.
+TEST(ScanNumerics, TileCrossingsAreTheirRule) {
+  std::mt19937 rng(4301u);
+  std::uniform_real_distribution<double> q(-12.0, 20.0), step(-2.0, 2.0), margin(0.0, 0.7);
+  std::size_t unsure = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    double q0 = q(rng);
+    const double st = trial % 5 == 0 ? 0.0 : step(rng);
+    const double m = trial % 3 == 0 ? 1e-9 : margin(rng);
+    if (trial % 7 == 0) q0 = std::round(q0) + (trial % 2 == 0 ? 1e-12 : -1e-12);
+    const wavog::detail::tile::Crossings x = wavog::detail::tile::crossings(q0, st, m);
+    ASSERT_EQ(x.low & x.high, 0u) << "trial " << trial;
+    for (unsigned l = 0; l < 8; ++l) {
+      const double c = q0 + static_cast<double>(l) * st;
+      for (unsigned p = 0; p < 8; ++p) {
+        const unsigned bit = p + 8 * l;
+        const double pos = static_cast<double>(p);
+        const bool low = (x.low >> bit) & 1u, high = (x.high >> bit) & 1u;
+        if (low) {
+          ASSERT_LT(pos, c - m) << "trial " << trial;
+        }
+        if (high) {
+          ASSERT_GT(pos, c + m) << "trial " << trial;
+        }
+        if (std::fabs(pos - (c - m)) > 1e-12) {
+          ASSERT_EQ(low, pos < c - m) << "trial " << trial;
+        }
+        if (std::fabs(pos - (c + m)) > 1e-12) {
+          ASSERT_EQ(high, pos > c + m) << "trial " << trial;
+        }
+        unsure += ((x.low | x.high) >> bit) & 1u ? 0 : 1;
+      }
+    }
+  }
+  EXPECT_GT(unsure, 0u);  // wide margins leave cells on neither side
+  // A boundary parallel to the lines (a zero component: step and margin infinite, line 0's
+  // crossing 0 x inf = NaN) leaves every cell of a NaN line on neither side.
+  const double inf = std::numeric_limits<double>::infinity();
+  for (double q0 : {-inf, inf, std::nan("")}) {
+    const wavog::detail::tile::Crossings x = wavog::detail::tile::crossings(q0, inf, inf);
+    EXPECT_EQ(x.low | x.high, 0u) << q0;
+  }
+  const wavog::detail::tile::Crossings nan_line =
+      wavog::detail::tile::crossings(3.5, std::nan(""), 1e-9);
+  EXPECT_EQ(nan_line.low | nan_line.high, 0u);
+}
+
+TEST(ScanNumerics, TileTransposeSwapsRowsAndColumns) {
+  std::mt19937_64 rng(17u);
+  for (int trial = 0; trial < 1000; ++trial) {
+    const std::uint64_t m = rng();
+    const std::uint64_t t = wavog::detail::tile::transpose(m);
+    for (unsigned x = 0; x < 8; ++x) {
+      for (unsigned y = 0; y < 8; ++y) {
+        ASSERT_EQ((t >> (y + 8 * x)) & 1u, (m >> (x + 8 * y)) & 1u);
+      }
+    }
+  }
+}

@@ -36,6 +36,11 @@ struct CellMasks {
   std::uint32_t e = 0, o = 0;
 };
 
+/// The classes of the 64 cells of an 8 x 8 tile, cell (x, y) at bit x + 8 y: E, O, U for neither.
+struct TileMasks {
+  std::uint64_t e = 0, o = 0;
+};
+
 class ScanClassifier {
  public:
   /// Prepares `scan` taken from `pose` (see PreparedScan::prepare); beam counts go to `st`.
@@ -67,6 +72,10 @@ class ScanClassifier {
   std::array<CellMasks, 4> classify8x8(std::int64_t ix0, std::int64_t iy0,
                                        const SquareInfo& square) const;
 
+  /// classifyCell() for the 64 cells of the 8 x 8 square at (ix0, iy0) classified as `square`
+  /// (fewSectors(square)), by row runs (scan_classifier_tile_inl.h).
+  TileMasks classifyTile(std::int64_t ix0, std::int64_t iy0, const SquareInfo& square) const;
+
   static constexpr int kFewSectors = 32;
 
  private:
@@ -76,6 +85,13 @@ class ScanClassifier {
   };
 
   CellClass cellAt(std::size_t j, double d2) const;
+  static std::uint32_t tileGroup(std::uint64_t v, unsigned shift);
+  /// Bounds of the squared distances of a tile's cells.
+  struct TileRange {
+    double lo, hi;
+  };
+  void classifySector(int j, std::uint64_t cells, const double* a2, const double* l2,
+                      const TileRange& d2, TileMasks* m) const;
   bool isHitCell(std::int64_t ix, std::int64_t iy, const SquareInfo& box) const;
   template <std::size_t kSide>
   void classifyGroups(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box,
@@ -116,5 +132,6 @@ class ScanClassifier {
 
 #include "classify/scan_classifier_cells_inl.h"
 #include "classify/scan_classifier_squares_inl.h"
+#include "classify/scan_classifier_tile_inl.h"
 
 #endif  // WAVOG_MAPPING_SRC_CORE_CLASSIFY_SCAN_CLASSIFIER_H_

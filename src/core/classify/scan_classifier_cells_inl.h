@@ -97,9 +97,20 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
 
 inline std::array<CellMasks, 4> ScanClassifier::classify8x8(std::int64_t ix0, std::int64_t iy0,
                                                             const SquareInfo& box) const {
+  const TileMasks t = classifyTile(ix0, iy0, box);
   std::array<CellMasks, 4> m;
-  classifyGroups<8>(ix0, iy0, box, m.data());
+  for (unsigned q = 0; q < 4; ++q) {
+    const unsigned shift = 4 * (q & 1) + 32 * (q >> 1);
+    m[q] = {tileGroup(t.e, shift), tileGroup(t.o, shift)};
+  }
   return m;
+}
+
+/// The 4 x 4 group of tile mask v (bit x + 8 y) whose first cell is bit `shift`, as bits x + 4 y.
+inline std::uint32_t ScanClassifier::tileGroup(std::uint64_t v, unsigned shift) {
+  v >>= shift;
+  return static_cast<std::uint32_t>((v & 0xF) | ((v >> 4) & 0xF0) | ((v >> 8) & 0xF00) |
+                                    ((v >> 12) & 0xF000));
 }
 
 /// The 4 x 4 groups of the kSide x kSide square at (ix0, iy0) (a multiple of 4 each), group
