@@ -350,6 +350,18 @@ TEST(SiteParams, RefusesEveryBadValueNamingTheParameter) {
               std::string::npos)
         << why;
   }
+  // [3, 3] was taken: the same layer assembled and published twice.
+  XmlRpc::XmlRpcValue twice = siteParams("", {});
+  twice["scales"][1] = 3;
+  EXPECT_NE(refusal(twice).find("~scales must list the scales to assemble (each a whole number in "
+                                "[1, 12], published by every shard in publish_scales): entry 3 is "
+                                "listed twice"),
+            std::string::npos)
+      << refusal(twice);
+  XmlRpc::XmlRpcValue same_shard = siteParams("", {});
+  same_shard["shards"][1] = std::string("shard_a");
+  EXPECT_NE(refusal(same_shard).find("is listed twice: list each shard once"), std::string::npos)
+      << refusal(same_shard);
   XmlRpc::XmlRpcValue no_shards = siteParams("", {});
   no_shards["shards"] = XmlRpc::XmlRpcValue();
   EXPECT_NE(refusal(no_shards).find("~shards must list"), std::string::npos);

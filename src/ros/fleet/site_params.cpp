@@ -3,6 +3,7 @@
 
 #include <ros/names.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -85,6 +86,12 @@ SiteParams readSiteParams(const XmlRpc::XmlRpcValue& root_in) {
     if (!ros::names::validate(shard, error)) {
       throw std::invalid_argument("~shards entry '" + shard + "' is not a ROS namespace: " + error);
     }
+    for (const std::string& other : p.shards) {
+      if (ros::names::clean(other) == ros::names::clean(shard)) {
+        throw std::invalid_argument("~shards entry '" + shard +
+                                    "' is listed twice: list each shard once");
+      }
+    }
     p.shards.push_back(shard);
   }
   const std::string scales_rule =
@@ -99,6 +106,9 @@ SiteParams readSiteParams(const XmlRpc::XmlRpcValue& root_in) {
     const double s = isNumber(v) ? number(v) : 0.0;  // a whole double (4.0) is fine, 3.5 is not
     if (!(s >= 1.0 && s <= 12.0 && s == std::floor(s))) {
       throw std::invalid_argument(scales_rule + ": entry " + show(v) + " is not");
+    }
+    if (std::find(p.scales.begin(), p.scales.end(), static_cast<int>(s)) != p.scales.end()) {
+      throw std::invalid_argument(scales_rule + ": entry " + show(v) + " is listed twice");
     }
     p.scales.push_back(static_cast<int>(s));
   }
