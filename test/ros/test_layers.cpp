@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../../src/ros/map_publisher.h"
+#include "fan_scan.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
 #include "wavog_mapping/ros/config.h"
@@ -28,17 +29,7 @@ bool holds(const wavog::Raster& r, double x, double y) {
          y < r.originY() + static_cast<double>(r.box.height()) * r.cell_size;
 }
 
-void scanAt(wavog::WaveletMap* map, double x, double y) {
-  const std::vector<float> ranges(100, 3.0f);
-  wavog::ScanView v;
-  v.ranges = ranges.data();
-  v.count = ranges.size();
-  v.angle_min = -1.5;
-  v.angle_increment = 0.03;
-  v.range_min = 0.1;
-  v.range_max = 30.0;
-  ASSERT_EQ(map->integrate(wavog::Pose2{x, y, 0.0}, v).status, wavog::ScanStatus::kOk);
-}
+using fan_scan::scanAt;
 
 // Two rooms 600 m apart at 2 cm: 30,000 x 150 cells at scale 0 fit, 60,000 x 60,000 would not.
 TEST(Layers, TooLargeWholeLayerIsTheWindowAroundTheRobot) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "../../src/ros/save_path.h"
+#include "fan_scan.h"
 #include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/ros/conversions.h"
 
@@ -101,17 +102,7 @@ wavog::MapParams smallParams() {
   return p;
 }
 
-void scanAt(wavog::WaveletMap* map, double x, double y) {
-  const std::vector<float> ranges(100, 3.0f);
-  wavog::ScanView v;
-  v.ranges = ranges.data();
-  v.count = ranges.size();
-  v.angle_min = -1.5;
-  v.angle_increment = 0.03;
-  v.range_min = 0.1;
-  v.range_max = 30.0;
-  ASSERT_EQ(map->integrate(wavog::Pose2{x, y, 0.0}, v).status, wavog::ScanStatus::kOk);
-}
+using fan_scan::scanAt;
 
 TEST(LayerBox, EmptyMapWholeMapAndWindow) {
   wavog::WaveletMap map(smallParams());
