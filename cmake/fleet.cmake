@@ -95,6 +95,17 @@ if(CATKIN_ENABLE_TESTING AND TARGET wavog_simulate AND TARGET wavog_mapping_node
                    wavog_fleet wavog_fleet_nodelet wavog_fleet_test_bag)
 endif()
 
+# ---- A vehicle that streams behind the others (test/fleet_lagging.test): waited for, not late ----
+if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet AND TARGET wavog_sim)
+  add_rostest_gtest(test_fleet_lagging test/fleet_lagging.test test/ros/test_fleet_lagging.cpp)
+  target_link_libraries(test_fleet_lagging wavog_ros wavog_ros_config wavog_sim wavog_core
+                        ${catkin_LIBRARIES} ${GTEST_LIBRARIES})
+  target_include_directories(test_fleet_lagging PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/ros)
+  target_compile_definitions(test_fleet_lagging PRIVATE
+    WAVOG_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  add_dependencies(test_fleet_lagging ${PROJECT_NAME}_generate_messages_cpp wavog_fleet)
+endif()
+
 # ---- The fleet map as a nodelet (test/fleet_nodelet.test): placed scans from the test itself ------
 if(CATKIN_ENABLE_TESTING AND TARGET wavog_fleet_nodelet)
   add_rostest_gtest(test_fleet_nodelet test/fleet_nodelet.test test/ros/test_fleet_nodelet.cpp)

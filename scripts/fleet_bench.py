@@ -110,8 +110,9 @@ def play_into_fleet(g, fleet_bag, rate):
         subprocess.run(["rosbag", "play", "--clock", "-q", "-r", str(rate), fleet_bag],
                        env=g.env, check=True)
         wall = time.time() - wall0
-        # The scans still in flight or buffered (at most fleet_reorder_wait) are counted in.
-        time.sleep(1.0)
+        # The scans still in flight or buffered are counted in: the last ones wait until the
+        # streams have been silent for fleet_stale_timeout (2 s), then fleet_reorder_wait (0.3 s).
+        time.sleep(3.0)
         cpu_play = cpu_seconds(fleet.pid) - cpu0
         # The last fleet_status: the clock stopped with the bag, and save_map publishes it.
         from wavog_mapping.srv import SaveMap

@@ -107,7 +107,9 @@ def main():
         wall0 = time.time()
         subprocess.run(["rosbag", "play", "--clock", "-q", bag], env=env, check=True)
         wall = time.time() - wall0
-        time.sleep(4.0)
+        # The mappers flush what waits for tf after idle_timeout (2 s), and the fleet node's last
+        # scans wait until the streams have been silent for fleet_stale_timeout (2 s).
+        time.sleep(5.0)
         cpu = cpu_seconds(fleet.pid) - cpu0
         print("fleet-demo: [3/5] saving the maps", flush=True)
         from wavog_mapping.srv import SaveMap

@@ -113,7 +113,9 @@ def run(g, bag, n, shards, rate):
         subprocess.run(["rosbag", "play", "--clock", "-q", "-d", "%g" % delay, "-r", str(rate),
                         bag], env=g.env, check=True)
         wall = time.time() - wall0 - delay
-        time.sleep(1.0)  # what is in flight or buffered (at most fleet_reorder_wait)
+        # What is in flight or buffered: the last scans wait until the streams have been silent
+        # for fleet_stale_timeout (2 s), then fleet_reorder_wait (0.3 s).
+        time.sleep(3.0)
         cpu = [cpu_seconds(p.pid) - c for p, c in zip(nodes, cpu0)]
         from wavog_mapping.srv import SaveMap
         for i in range(shards):  # publishes the last fleet_status (the clock stopped)

@@ -244,6 +244,8 @@ const std::vector<KeyReader>& readers() {
        [](auto& k, auto& v, Config* c) { c->ros.fleet_vehicles = asStringList(k, v); }},
       {"fleet_reorder_wait",
        [](auto& k, auto& v, Config* c) { c->ros.fleet_reorder_wait = asDouble(k, v); }},
+      {"fleet_reorder_max_wait",
+       [](auto& k, auto& v, Config* c) { c->ros.fleet_reorder_max_wait = asDouble(k, v); }},
       {"fleet_stale_timeout",
        [](auto& k, auto& v, Config* c) { c->ros.fleet_stale_timeout = asDouble(k, v); }},
       {"fleet_integrate_late",

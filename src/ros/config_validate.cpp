@@ -96,6 +96,12 @@ std::vector<std::string> validate(const RosParams& ros, const wavog::MapParams& 
   check(std::isfinite(ros.fleet_reorder_wait) && ros.fleet_reorder_wait >= 0.0 &&
             ros.fleet_reorder_wait <= 10.0,
         &e, "fleet_reorder_wait (" + fmt(ros.fleet_reorder_wait) + ") must be in [0, 10] s");
+  check(std::isfinite(ros.fleet_reorder_max_wait) &&
+            ros.fleet_reorder_max_wait >= ros.fleet_reorder_wait &&
+            ros.fleet_reorder_max_wait <= 600.0,
+        &e,
+        "fleet_reorder_max_wait (" + fmt(ros.fleet_reorder_max_wait) +
+            ") must be in [fleet_reorder_wait (" + fmt(ros.fleet_reorder_wait) + "), 600] s");
   check(std::isfinite(ros.fleet_stale_timeout) && ros.fleet_stale_timeout > 0.0 &&
             ros.fleet_stale_timeout <= 3600.0,
         &e, "fleet_stale_timeout (" + fmt(ros.fleet_stale_timeout) + ") must be in (0, 3600] s");

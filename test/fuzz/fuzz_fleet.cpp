@@ -1,15 +1,16 @@
 // libFuzzer harness: the fleet node's message path without a roscore, on PlacedScan messages with
 // every field mutated, from up to three vehicles, at a hostile fleet clock: the node's own intake
 // (intake.h: received, the index sequence, checkPlacedScan, the refusal counters), then the
-// reorder buffer and the core call as FleetReceiver composes them (late scans integrated or
-// dropped, overflow), and the stamp arithmetic it does on what passed.
+// reorder buffer with the streams' horizon and the core call as FleetReceiver composes them (late
+// scans integrated or dropped, overflow), and the stamp arithmetic it does on what passed.
 // Oracles: nothing throws, no undefined behaviour; per vehicle the counters add up (every received
 // message is refused by one reason, overflows, is late or is integrated / refused by the core) and
 // `lost`, index_regressions and index_jumps equal an independent 128-bit count of the index
 // sequence; a message that passed the checks is one the core takes without refusing its
 // geometry, at a stamp ros::Time arithmetic can handle, with a period a mapper sends ([0,
 // ScanPeriod::kMaxPeriod]), and one refused as bad size has an absurd period or is one the core
-// refuses as bad geometry (or empty); the map stays finite at every scale.
+// refuses as bad geometry (or empty); the buffer releases in key order; the map stays finite at
+// every scale.
 #include <ros/time.h>
 
 #include <cmath>
@@ -21,6 +22,7 @@
 #include "fleet/intake.h"
 #include "fleet/placed_scan.h"
 #include "fleet/reorder_buffer.h"
+#include "fleet/stream_horizon.h"
 #include "fleet/stream_index.h"
 #include "fuzz_support.h"
 #include "wavog_mapping/PlacedScan.h"
@@ -174,8 +176,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   limits.max_stamp_offset = in.ConsumeBool() ? 60.0 : in.ConsumeFloatingPointInRange<double>(1e-3, 86400.0);
   const bool integrate_late = in.ConsumeBool();
   const double wait = in.ConsumeFloatingPointInRange<double>(0.0, 1.0);
-  wavog_fleet::ReorderBuffer<Msg> buffer(wait, in.ConsumeIntegralInRange<std::size_t>(1, 4));
+  const double max_wait = wait + in.ConsumeFloatingPointInRange<double>(0.0, 2.0);
+  wavog_fleet::ReorderBuffer<Msg> buffer(wait, max_wait,
+                                         in.ConsumeIntegralInRange<std::size_t>(1, 4));
   std::vector<Vehicle> vehicles(in.ConsumeIntegralInRange<std::size_t>(1, 3));
+  // As FleetReceiver: the streams' progress (live for fleet_stale_timeout) bounds the release.
+  wavog_fleet::StreamHorizon horizon(vehicles.size(),
+                                     in.ConsumeFloatingPointInRange<double>(0.01, 2.0),
+                                     in.ConsumeIntegralInRange<std::size_t>(1, 3));
 
   // The fleet clock (ros::Time::now(): normalised) and the wall clock of the arrivals.
   ros::Time now;
@@ -201,7 +209,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const double lag = wavog_ros::secondsBetween(now, m.header.stamp);  // as integrateLocked
     WAVOG_FUZZ_CHECK(std::isfinite(lag), "lag %g", lag);
   };
+  wavog_fleet::OrderKey last_key;
+  bool has_last_key = false;
   const auto release = [&](const wavog_fleet::OrderKey& key, const Msg& m) {
+    // The buffer releases in key order, whatever the horizon did.
+    WAVOG_FUZZ_CHECK(!has_last_key || !(key < last_key), "released out of key order");
+    last_key = key;
+    has_last_key = true;
     Vehicle& v = vehicles[static_cast<std::size_t>(key.vehicle)];
     ++v.released;
     integrate(&v, *m);
@@ -253,6 +267,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         v.c.last_stamp = m->header.stamp;
         const wavog_fleet::OrderKey key{static_cast<std::int64_t>(m->header.stamp.toNSec()),
                                         static_cast<int>(vi), m->index};
+        horizon.note(vi, m->input, key.stamp_ns, wall);
         switch (buffer.push(key, wall, m)) {
           case wavog_fleet::Admission::kQueued:
             ++v.queued;
@@ -270,7 +285,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             break;
         }
       }
-      buffer.release(wall, release);
+      buffer.release(wall, horizon.horizon(wall), release);
     }
     buffer.releaseAll(release);
   } catch (const std::exception& e) {

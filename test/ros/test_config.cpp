@@ -216,6 +216,19 @@ TEST(Config, FleetStreamFormatIsOneOfTwo) {
   EXPECT_NE(errorOf("{fleet_stream_format: 16}").find("fleet_stream_format"), std::string::npos);
 }
 
+TEST(Config, FleetReorderMaxWaitIsAtLeastTheWait) {
+  EXPECT_EQ(errorOf("{fleet_reorder_wait: 0.5, fleet_reorder_max_wait: 0.5}"), "");
+  EXPECT_EQ(errorOf("{fleet_reorder_max_wait: 600}"), "");
+  const std::string low = errorOf("{fleet_reorder_wait: 2, fleet_reorder_max_wait: 1}");
+  EXPECT_NE(low.find("fleet_reorder_max_wait (1) must be in [fleet_reorder_wait (2), 600] s"),
+            std::string::npos)
+      << low;
+  EXPECT_NE(errorOf("{fleet_reorder_max_wait: 601}").find("fleet_reorder_max_wait (601)"),
+            std::string::npos);
+  EXPECT_NE(errorOf("{fleet_reorder_max_wait: .nan}").find("fleet_reorder_max_wait"),
+            std::string::npos);
+}
+
 TEST(Config, ReportsUnknownKeys) {
   std::vector<std::string> unknown;
   fromYaml("{resolutoin: 0.1, publish_rate: 2}", &unknown);

@@ -7,16 +7,18 @@
 #include <ros/serialization.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <tuple>
 #include <vector>
 
 #include "fleet/placed_scan.h"
 #include "fleet/reorder_buffer.h"
+#include "fleet/stream_horizon.h"
 #include "map_compare.h"
 #include "placed_scan_fixture.h"
 #include "wavog_mapping/core/scan_period.h"
@@ -49,7 +51,7 @@ TEST(ReorderBuffer, ReleasesInKeyOrderWhateverTheArrivalOrder) {
   for (const OrderKey& k : keys) arrivals.push_back({k.stamp_ns / 1000.0 + delay(rng), k});
   std::sort(arrivals.begin(), arrivals.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
-  ReorderBuffer<int> buffer(0.3, 100000);
+  ReorderBuffer<int> buffer(0.3, 0.3, 100000);
   std::vector<OrderKey> out;
   auto sink = [&](const OrderKey& k, int) { out.push_back(k); };
   for (const auto& a : arrivals) {
@@ -67,7 +69,7 @@ TEST(ReorderBuffer, ReleasesInKeyOrderWhateverTheArrivalOrder) {
 }
 
 TEST(ReorderBuffer, HoldsAnItemForTheWaitAndNoLonger) {
-  ReorderBuffer<int> buffer(0.5, 10);
+  ReorderBuffer<int> buffer(0.5, 0.5, 10);
   int released = 0;
   auto sink = [&](const OrderKey&, int) { ++released; };
   ASSERT_EQ(buffer.push(key(100, 0, 0), 10.0, 0), Admission::kQueued);
@@ -78,7 +80,7 @@ TEST(ReorderBuffer, HoldsAnItemForTheWaitAndNoLonger) {
 
 TEST(ReorderBuffer, ASilentVehicleHoldsNothingUp) {
   // Vehicle 1 never sends again: vehicle 0's items still go out after the wait.
-  ReorderBuffer<int> buffer(0.2, 10);
+  ReorderBuffer<int> buffer(0.2, 0.2, 10);
   std::vector<OrderKey> out;
   auto sink = [&](const OrderKey& k, int) { out.push_back(k); };
   ASSERT_EQ(buffer.push(key(5, 1, 0), 0.0, 0), Admission::kQueued);
@@ -92,7 +94,7 @@ TEST(ReorderBuffer, ASilentVehicleHoldsNothingUp) {
 }
 
 TEST(ReorderBuffer, AnItemOlderThanTheLastReleasedIsLate) {
-  ReorderBuffer<int> buffer(0.1, 10);
+  ReorderBuffer<int> buffer(0.1, 0.1, 10);
   auto sink = [](const OrderKey&, int) {};
   ASSERT_EQ(buffer.push(key(100, 0, 0), 0.0, 0), Admission::kQueued);
   ASSERT_EQ(buffer.release(0.2, sink), 1u);
@@ -104,7 +106,7 @@ TEST(ReorderBuffer, AnItemOlderThanTheLastReleasedIsLate) {
 }
 
 TEST(ReorderBuffer, RefusesBeyondItsCapacity) {
-  ReorderBuffer<int> buffer(1.0, 2);
+  ReorderBuffer<int> buffer(1.0, 1.0, 2);
   EXPECT_EQ(buffer.push(key(1, 0, 0), 0.0, 0), Admission::kQueued);
   EXPECT_EQ(buffer.push(key(2, 0, 1), 0.0, 0), Admission::kQueued);
   EXPECT_EQ(buffer.push(key(3, 0, 2), 0.0, 0), Admission::kOverflow);
@@ -112,6 +114,196 @@ TEST(ReorderBuffer, RefusesBeyondItsCapacity) {
   EXPECT_EQ(buffer.releaseAll([&](const OrderKey& k, int) { out.push_back(k); }), 2u);
   ASSERT_EQ(out.size(), 2u);
   EXPECT_EQ(out[0].stamp_ns, 1);
+}
+
+// ---- the streams' horizon: a stream that lags but streams holds the others ----------------------
+
+using wavog_fleet::StreamHorizon;
+
+struct Arrival {
+  double at;  ///< wall s
+  OrderKey key;
+  std::string input;
+};
+
+struct Replayed {
+  std::vector<OrderKey> released;
+  std::size_t late = 0;
+  std::size_t max_buffered = 0;
+};
+
+/// FleetReceiver's path on `arrivals` (sorted by time): note() and push() at each arrival, the
+/// release timer every 10 ms; with `horizon` false the release is by arrival times alone (the
+/// rule before the horizon). Late items are counted, not released.
+Replayed replay(const std::vector<Arrival>& arrivals, double wait, double max_wait, double live_for,
+                bool horizon) {
+  ReorderBuffer<int> buffer(wait, max_wait, 1000000);
+  StreamHorizon streams(4, live_for);
+  Replayed run;
+  auto sink = [&](const OrderKey& k, int) { run.released.push_back(k); };
+  auto releaseAt = [&](double t) {
+    buffer.release(t, horizon ? streams.horizon(t) : wavog_fleet::kNoHorizon, sink);
+  };
+  double tick = 0.0;
+  for (const Arrival& a : arrivals) {
+    for (; tick <= a.at; tick += 0.01) releaseAt(tick);
+    streams.note(static_cast<std::size_t>(a.key.vehicle), a.input, a.key.stamp_ns, a.at);
+    if (buffer.push(a.key, a.at, 0) == Admission::kLate) ++run.late;
+    run.max_buffered = std::max(run.max_buffered, buffer.size());
+  }
+  const double end = arrivals.empty() ? 0.0 : arrivals.back().at + max_wait + 0.02;
+  for (; tick <= end; tick += 0.01) releaseAt(tick);
+  EXPECT_EQ(buffer.size(), 0u) << "everything goes within max_wait of its arrival";
+  return run;
+}
+
+/// Vehicles with four 40 Hz lasers each (stamps staggered per laser), `seconds` long; each scan
+/// arrives 30 ms after its stamp plus its vehicle's lag, which grows by 0.5 s a second up to
+/// `lag[vehicle]` s (a loaded mapper's backlog), and per vehicle the lasers' scans are
+/// interleaved out of stamp order by up to 20 ms, as a mapper sends them.
+std::vector<Arrival> lasers(double seconds, const std::vector<double>& lag) {
+  std::vector<Arrival> out;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> jitter(0.0, 0.02);
+  for (int v = 0; v < static_cast<int>(lag.size()); ++v) {
+    std::uint64_t index = 0;
+    for (int i = 0; i < static_cast<int>(seconds * 40); ++i) {
+      for (int l = 0; l < 4; ++l) {
+        const double stamp = 1.0 + i * 0.025 + l * 0.005;
+        const OrderKey k{static_cast<std::int64_t>(std::llround(stamp * 1e9)), v, index++};
+        const double behind = std::min(lag[static_cast<std::size_t>(v)], 0.5 * (stamp - 1.0));
+        out.push_back({stamp + 0.03 + behind + jitter(rng), k, "scan_" + std::to_string(l)});
+      }
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const Arrival& a, const Arrival& b) { return a.at < b.at; });
+  // A vehicle's index follows its stream order (the order it sent them).
+  std::vector<std::uint64_t> next(lag.size(), 0);
+  for (Arrival& a : out) a.key.index = next[static_cast<std::size_t>(a.key.vehicle)]++;
+  return out;
+}
+
+std::vector<OrderKey> sortedKeys(const std::vector<Arrival>& arrivals) {
+  std::vector<OrderKey> keys;
+  for (const Arrival& a : arrivals) keys.push_back(a.key);
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+bool sameKeys(const std::vector<OrderKey>& a, const std::vector<OrderKey>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] < b[i] || b[i] < a[i]) return false;
+  }
+  return true;
+}
+
+TEST(ReorderBuffer, AVehicleThatLagsButStreamsHoldsTheOthersInsteadOfComingLate) {
+  // fleet.test's failure under load: one vehicle's stream falls 1 s behind the others', more
+  // than the wait (0.3 s). By arrival time alone most of its scans are late; with the horizon
+  // none is, and the fleet releases every scan in stamp order.
+  const std::vector<Arrival> arrivals = lasers(5.0, {0.0, 1.0, 0.0});
+  const Replayed before = replay(arrivals, 0.3, 10.0, 2.0, false);
+  EXPECT_GT(before.late, arrivals.size() / 6) << "the case the horizon is for";
+  const Replayed after = replay(arrivals, 0.3, 10.0, 2.0, true);
+  std::printf(
+      "a vehicle 1 s behind: %zu of %zu scans late by arrival time alone, %zu with the "
+      "horizon\n",
+      before.late, arrivals.size(), after.late);
+  EXPECT_EQ(after.late, 0u);
+  EXPECT_TRUE(sameKeys(after.released, sortedKeys(arrivals)));
+  // Memory: the lag's worth of the others' scans (2 vehicles x 160 Hz x 1.3 s), not more.
+  EXPECT_LT(after.max_buffered, 3u * 160u * 1.5);
+  // The same with the lag on the first vehicle, and growing lags on two of them.
+  for (const std::vector<double>& lag :
+       {std::vector<double>{2.5, 0.0, 0.0}, std::vector<double>{0.0, 4.0, 7.0}}) {
+    const std::vector<Arrival> a = lasers(4.0, lag);
+    const Replayed r = replay(a, 0.3, 10.0, 2.0, true);
+    EXPECT_EQ(r.late, 0u);
+    EXPECT_TRUE(sameKeys(r.released, sortedKeys(a)));
+  }
+}
+
+TEST(ReorderBuffer, AStreamLaggingBeyondTheMaxWaitHoldsNoLonger) {
+  // Vehicle 1's clock runs 20 s behind: it streams, but its stamps never pass the others'.
+  // Vehicle 0's scans wait max_wait (2 s) and go; vehicle 1's then come late (counted).
+  std::vector<Arrival> arrivals;
+  for (int i = 0; i < 200; ++i) {
+    const double t = 1.0 + i * 0.025;  // wall s; vehicle 0 stamps t + 100 s, vehicle 1 t + 80 s
+    const auto index = static_cast<std::uint64_t>(i);
+    arrivals.push_back({t, OrderKey{std::llround((t + 100.0) * 1e9), 0, index}, "a"});
+    arrivals.push_back({t + 0.001, OrderKey{std::llround((t + 80.0) * 1e9), 1, index}, "a"});
+  }
+  ReorderBuffer<int> buffer(0.3, 2.0, 1000000);
+  StreamHorizon streams(2, 1.0);
+  std::vector<OrderKey> out;
+  auto sink = [&](const OrderKey& k, int) { out.push_back(k); };
+  std::size_t late = 0;
+  for (const Arrival& a : arrivals) {
+    buffer.release(a.at, streams.horizon(a.at), sink);
+    streams.note(static_cast<std::size_t>(a.key.vehicle), a.input, a.key.stamp_ns, a.at);
+    late += buffer.push(a.key, a.at, 0) == Admission::kLate;
+  }
+  // Vehicle 0's first scan (arrived at 1.0) is held past the wait by vehicle 1's horizon ...
+  EXPECT_GT(late, 0u);
+  // ... and released at 1.0 + max_wait at the latest: nothing older than that stays.
+  buffer.release(1.0 + 2.0, streams.horizon(3.0), sink);
+  bool first_out = false;
+  for (const OrderKey& k : out) first_out |= k.vehicle == 0 && k.index == 0;
+  EXPECT_TRUE(first_out);
+  EXPECT_LE(buffer.size(), 2u * 200u);
+}
+
+TEST(ReorderBuffer, AStreamSilentForItsLiveTimeHoldsNothing) {
+  // Vehicle 1 stops at 2 s (killed); vehicle 0 streams on. Once vehicle 1 has been silent for
+  // the live time (0.5 s), vehicle 0's scans go after the wait (0.2 s), as before the horizon.
+  ReorderBuffer<int> buffer(0.2, 10.0, 100000);
+  StreamHorizon streams(2, 0.5);
+  std::vector<OrderKey> out;
+  auto sink = [&](const OrderKey& k, int) { out.push_back(k); };
+  std::uint64_t i0 = 0, i1 = 0;
+  for (double t = 1.0; t < 4.0; t += 0.025) {
+    buffer.release(t, streams.horizon(t), sink);
+    const std::int64_t ns = std::llround(t * 1e9);
+    streams.note(0, "a", ns, t);
+    ASSERT_EQ(buffer.push(OrderKey{ns, 0, i0++}, t, 0), Admission::kQueued);
+    if (t < 2.0) {
+      streams.note(1, "a", ns + 1, t);
+      ASSERT_EQ(buffer.push(OrderKey{ns + 1, 1, i1++}, t, 0), Admission::kQueued);
+    }
+  }
+  // At 3.5 s: vehicle 1 silent since ~2.0 s: everything that arrived up to 3.3 s is out.
+  buffer.release(3.5, streams.horizon(3.5), sink);
+  ASSERT_FALSE(out.empty());
+  EXPECT_GE(out.back().stamp_ns, std::llround(3.28 * 1e9));
+  // While it streamed, a scan waited for it: none went before the other vehicle passed it.
+  EXPECT_TRUE(std::is_sorted(out.begin(), out.end()));
+}
+
+TEST(StreamHorizon, TheSmallestLastStampOfTheLiveStreams) {
+  StreamHorizon h(3, 1.0, 2);
+  EXPECT_EQ(h.horizon(0.0), wavog_fleet::kNoHorizon);  // nothing heard: nothing holds
+  ASSERT_TRUE(h.note(0, "front", 100, 0.0));
+  ASSERT_TRUE(h.note(0, "rear", 90, 0.0));  // a vehicle's inputs interleave: the least counts
+  ASSERT_TRUE(h.note(1, "front", 95, 0.5));
+  EXPECT_EQ(h.horizon(0.5), 90);
+  ASSERT_TRUE(h.note(0, "rear", 120, 0.6));
+  EXPECT_EQ(h.horizon(0.6), 95);
+  // Vehicle 0's front is silent for more than 1 s at 1.1 s: its 100 no longer holds.
+  ASSERT_TRUE(h.note(1, "front", 130, 1.05));
+  EXPECT_EQ(h.horizon(1.1), 120);
+  // A stream that jumps back (a restarted bag) holds at its new stamp.
+  ASSERT_TRUE(h.note(1, "front", 50, 1.2));
+  EXPECT_EQ(h.horizon(1.2), 50);
+  // Out of range: not tracked.
+  EXPECT_FALSE(h.note(7, "front", 1, 1.2));
+  // Once one of a vehicle's two streams is silent (front since 0.0), a third input takes its
+  // place; while both are live, a third is not tracked and holds nothing.
+  EXPECT_TRUE(h.note(0, "side", 200, 1.3));
+  EXPECT_EQ(h.streams(0), 2u);
+  EXPECT_FALSE(h.note(0, "top", 1, 1.4));
+  EXPECT_EQ(h.horizon(1.4), 50);
+  EXPECT_EQ(h.horizon(10.0), wavog_fleet::kNoHorizon);  // all silent
 }
 
 // ---- foreign input -----------------------------------------------------------------------------
@@ -309,7 +501,7 @@ void expectMergeRuleForEveryPolicy(bool codes) {
 
     // The fleet node's path: checks, the reorder buffer, the decoded core call.
     wavog::WaveletMap fleet(params);
-    ReorderBuffer<std::size_t> buffer(0.3, 100000);
+    ReorderBuffer<std::size_t> buffer(0.3, 0.3, 100000);
     std::size_t integrated = 0;
     auto integrate = [&](const OrderKey&, std::size_t i) {
       const auto& m = scans[i].msg;

@@ -13,6 +13,7 @@
 #include <ros/network.h>
 #include <ros/ros.h>
 #include <signal.h>
+#include <std_srvs/Trigger.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -96,6 +97,13 @@ struct Recorder {
 bool saveMap(const std::string& service, const std::string& path) {
   wavog_mapping::SaveMap srv;
   srv.request.path = path;
+  if (!ros::service::waitForService(service, ros::Duration(10.0))) return false;
+  return ros::service::call(service, srv) && srv.response.success;
+}
+
+/// Calls a node's ~flush (std_srvs/Trigger): true once it answered with success.
+bool flush(const std::string& service) {
+  std_srvs::Trigger srv;
   if (!ros::service::waitForService(service, ros::Duration(10.0))) return false;
   return ros::service::call(service, srv) && srv.response.success;
 }
@@ -204,8 +212,32 @@ TEST(Fleet, ThreeVehiclesOneMap) {
     ros::WallDuration(0.05).sleep();
   }
   player_child.pid = -1;  // exited and reaped
-  // Everything streamed has passed the reorder wait (3 s) and the mappers' end-of-input flush.
-  ros::WallDuration(5.0).sleep();
+  // The end of the input, by state rather than by time (a loaded machine takes longer): the live
+  // mappers flush what waits for tf and stream it, and the fleet node has received every scan
+  // the test recorded and holds none in its reorder buffer (fleet_reorder_wait, then the
+  // horizon: v1 and v3 silent for fleet_stale_timeout), with no new scan for 4 polls a second
+  // apart (longer than the mappers' idle_timeout, after which they flush by themselves).
+  ASSERT_TRUE(flush("/v1/wavog_mapping/flush"));
+  if (v3 > 0) ASSERT_TRUE(flush("/v3/wavog_mapping/flush"));
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(120.0);
+  std::vector<std::size_t> counts;
+  for (int settled = 0; settled < 4;) {
+    ASSERT_LT(ros::WallTime::now(), give_up) << "the fleet node never received and integrated "
+                                                "every streamed scan";
+    ros::WallDuration(1.0).sleep();
+    ASSERT_TRUE(flush("/wavog_fleet/flush"));  // publishes ~fleet_status
+    ros::WallDuration(0.2).sleep();
+    std::lock_guard<std::mutex> lock(rec.mutex);
+    bool done =
+        rec.status && rec.status->buffered == 0 && rec.status->vehicles.size() == kVehicles.size();
+    std::vector<std::size_t> now_counts;
+    for (std::size_t k = 0; k < kVehicles.size(); ++k) {
+      now_counts.push_back(rec.scans[k].size());
+      done = done && rec.status->vehicles[k].received == rec.scans[k].size();
+    }
+    settled = done && now_counts == counts ? settled + 1 : 0;
+    counts = now_counts;
+  }
   ASSERT_TRUE(saveMap("/wavog_fleet/save_map", stem + "_fleet.wmap"));
   ASSERT_TRUE(saveMap("/v1/wavog_mapping/save_map", stem + "_v1.wmap"));
   ASSERT_GT(v3, 0);

@@ -95,8 +95,12 @@ struct RosParams {
   /// <namespace>/fleet_scans. Mappers ignore it.
   std::vector<std::string> fleet_vehicles;
   /// Fleet node: how long (wall s) a scan waits in the reorder buffer for older scans of other
-  /// vehicles before it is integrated, in [0, 10].
+  /// vehicles (and of vehicles not yet streaming) before it is integrated, in [0, 10]; after
+  /// that it waits on while a stream still streaming has not delivered a later stamp.
   double fleet_reorder_wait = 0.3;
+  /// Fleet node: the longest (wall s) a scan waits for a stream that still streams but lags, in
+  /// [fleet_reorder_wait, 600]; fleet_reorder_wait: release by arrival time only.
+  double fleet_reorder_max_wait = 10.0;
   /// Fleet node: wall s without a message after which a vehicle is stale, in (0, 3600].
   double fleet_stale_timeout = 2.0;
   /// Fleet node: a scan older than the newest integrated one is integrated anyway (true) or

@@ -42,8 +42,7 @@ struct FleetReceiver::Vehicle {
 };
 
 FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
-                             const wavog_ros::RosParams& ros, double resolution,
-                             std::mutex* mutex,
+                             const wavog_ros::RosParams& ros, double resolution, std::mutex* mutex,
                              IntegrateFn integrate, diagnostic_updater::Updater* updater)
     : nh_(nh),
       pnh_(pnh),
@@ -51,9 +50,12 @@ FleetReceiver::FleetReceiver(ros::NodeHandle nh, ros::NodeHandle pnh,
       stale_timeout_(ros.fleet_stale_timeout),
       integrate_late_(ros.fleet_integrate_late),
       reorder_wait_(ros.fleet_reorder_wait),
+      reorder_max_wait_(ros.fleet_reorder_max_wait),
       mutex_(mutex),
       integrate_(std::move(integrate)),
-      buffer_(ros.fleet_reorder_wait, static_cast<std::size_t>(ros.fleet_max_buffered)) {
+      buffer_(ros.fleet_reorder_wait, ros.fleet_reorder_max_wait,
+              static_cast<std::size_t>(ros.fleet_max_buffered)),
+      horizon_(ros.fleet_vehicles.size(), ros.fleet_stale_timeout) {
   if (ros.fleet_vehicles.empty()) {
     throw std::invalid_argument(
         "fleet_vehicles must list 1 to " + std::to_string(wavog_ros::kMaxFleetVehicles) +
@@ -140,6 +142,14 @@ void FleetReceiver::onMessage(Vehicle* v,
   }
   c.last_stamp = m->header.stamp;
   const OrderKey key{toNs(m->header.stamp), v->index, m->index};
+  // The stream's progress counts whether the scan is queued or late: either way nothing older
+  // follows it on its input.
+  if (!horizon_.note(static_cast<std::size_t>(v->index), m->input, key.stamp_ns, now.toSec())) {
+    warnLocked(v, "input '" + m->input.substr(0, 64) + "' is one input more than the " +
+                      std::to_string(horizon_.streams(static_cast<std::size_t>(v->index))) +
+                      " tracked: the reorder buffer does not wait for it (its scans may come "
+                      "late)");
+  }
   switch (buffer_.push(key, now.toSec(), m)) {
     case Admission::kQueued:
       return;
@@ -159,7 +169,9 @@ void FleetReceiver::onMessage(Vehicle* v,
                         " s arrived after a newer one was integrated (" +
                         (integrate_late_ ? std::to_string(c.integrated_late) + " integrated late"
                                          : std::to_string(c.dropped_late) + " dropped") +
-                        " so far; fleet_reorder_wait " + std::to_string(reorder_wait_) + " s)");
+                        " so far; fleet_reorder_wait " + std::to_string(reorder_wait_) +
+                        " s, fleet_reorder_max_wait " + std::to_string(reorder_max_wait_) +
+                        " s, fleet_stale_timeout " + std::to_string(stale_timeout_) + " s)");
       return;
   }
 }
@@ -167,7 +179,7 @@ void FleetReceiver::onMessage(Vehicle* v,
 void FleetReceiver::onReleaseTimer() {
   const double now = ros::WallTime::now().toSec();
   std::lock_guard<std::mutex> lock(*mutex_);
-  buffer_.release(now, [this](const OrderKey& key, const Item& m) {
+  buffer_.release(now, horizon_.horizon(now), [this](const OrderKey& key, const Item& m) {
     integrateLocked(vehicles_[static_cast<std::size_t>(key.vehicle)].get(), *m);
   });
 }

@@ -1,10 +1,13 @@
 // FleetReceiver: the fleet node's inputs (wavog_fleet). One subscription per vehicle namespace
 // (<ns>/fleet_scans, PlacedScan), each message checked (placed_scan.h), then held in a
-// ReorderBuffer and handed to the map in stamp order after at most fleet_reorder_wait (wall s);
-// late, foreign and overflowing messages are counted by vehicle and reason, warned with a
-// throttle; every stamp arithmetic is in double seconds (a hostile stamp cannot throw), and the
-// per-vehicle index sequence (stream_index.h) counts lost messages exactly. A vehicle silent for fleet_stale_timeout is stale (diagnostics WARN, ~fleet_status);
-// nothing waits for it, and its cells stay in the map like any region no longer observed.
+// ReorderBuffer and handed to the map in stamp order: a scan waits fleet_reorder_wait (wall s),
+// and beyond that until every stream still streaming (one per vehicle and input, StreamHorizon)
+// has delivered a later stamp, at most fleet_reorder_max_wait; late, foreign and overflowing
+// messages are counted by vehicle and reason, warned with a throttle; every stamp arithmetic is
+// in double seconds (a hostile stamp cannot throw), and the per-vehicle index sequence
+// (stream_index.h) counts lost messages exactly. A vehicle silent for fleet_stale_timeout is
+// stale (diagnostics WARN, ~fleet_status); nothing waits for it, and its cells stay in the map
+// like any region no longer observed.
 // Locking: every member is guarded by the mapper's one mutex (passed in), and the integration
 // callback runs under it.
 #ifndef WAVOG_MAPPING_SRC_ROS_FLEET_FLEET_RECEIVER_H_
@@ -22,6 +25,7 @@
 #include "../checked_subscription.h"
 #include "placed_scan.h"
 #include "reorder_buffer.h"
+#include "stream_horizon.h"
 #include "stream_index.h"
 #include "wavog_mapping/FleetStatus.h"
 #include "wavog_mapping/PlacedScan.h"
@@ -74,11 +78,13 @@ class FleetReceiver {
   double stale_timeout_;
   bool integrate_late_;
   double reorder_wait_;
+  double reorder_max_wait_;
   std::mutex* mutex_;
   IntegrateFn integrate_;
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
   std::vector<float> decoded_;  ///< a version-2 scan's ranges (under *mutex_)
   ReorderBuffer<Item> buffer_;
+  StreamHorizon horizon_;  ///< how far every live stream has come (wall time of receipt)
   ros::Time integrated_stamp_;
   ros::Publisher status_pub_;
   ros::WallTimer release_timer_;
