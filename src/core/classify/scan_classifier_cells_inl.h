@@ -97,8 +97,12 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
 
 inline std::array<CellMasks, 4> ScanClassifier::classify8x8(std::int64_t ix0, std::int64_t iy0,
                                                             const SquareInfo& box) const {
-  const TileMasks t = classifyTile(ix0, iy0, box);
   std::array<CellMasks, 4> m;
+  if (!box.single && box.shi - box.slo > kTileMaxBoundaries) {  // cell by cell is cheaper
+    classifyGroups<8>(ix0, iy0, box, m.data());
+    return m;
+  }
+  const TileMasks t = classifyTile(ix0, iy0, box);
   for (unsigned q = 0; q < 4; ++q) {
     const unsigned shift = 4 * (q & 1) + 32 * (q >> 1);
     m[q] = {tileGroup(t.e, shift), tileGroup(t.o, shift)};
