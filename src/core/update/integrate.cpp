@@ -168,16 +168,24 @@ std::uint64_t updateBlocksFor(WaveletMap::Impl& impl, detail::NodeStore& store,
   return detail::updateBlocks<P, false>(impl, store, cls, pc, ndt, hits, jobs, next);
 }
 
-// The worker threads of `impl` for a scan that has `jobs` pieces of work (made on first use, or
-// again when num_threads changed), and how many of them take part; 1 means the calling thread
-// alone (no pool is made).
+// The worker threads of a map of parameters `p` (made on first use, or again when num_threads
+// changed); nullptr when it integrates on the calling thread alone (no pool is made).
+detail::WorkerPool* poolFor(const MapParams& p, std::unique_ptr<detail::WorkerPool>* workers) {
+  const int threads = threadsFor(p);
+  if (threads <= 1) return nullptr;
+  if (!*workers || (*workers)->threads() != threads) {
+    *workers = std::make_unique<detail::WorkerPool>(threads);
+  }
+  return workers->get();
+}
+
+// The worker threads of `impl` for a scan that has `jobs` pieces of work (poolFor), and how many
+// of them take part; 1 means the calling thread alone.
 int workersFor(const WaveletMap::Impl& impl, std::size_t jobs,
                std::unique_ptr<detail::WorkerPool>* workers) {
   const int threads = std::min(threadsFor(impl.params), static_cast<int>(jobs));
   if (threads <= 1) return 1;
-  if (!*workers || (*workers)->threads() != threadsFor(impl.params)) {
-    *workers = std::make_unique<detail::WorkerPool>(threadsFor(impl.params));
-  }
+  poolFor(impl.params, workers);
   return threads;
 }
 
@@ -361,7 +369,11 @@ IntegrateStats WaveletMap::integrate(const Pose2& sensor_pose, const ScanView& s
     return st;
   }
   thread_local ScanClassifier classifier;
-  st.status = classifier.prepare(impl_->params, sensor_pose, scan, &st);
+  {
+    // The map's threads share the preparation's per-beam work.
+    const detail::PrepareHelpers helpers(poolFor(impl_->params, &impl_->workers));
+    st.status = classifier.prepare(impl_->params, sensor_pose, scan, &st);
+  }
   if (st.status != ScanStatus::kOk) {
     classifier.releaseIfLarge();
     impl_->nodes_visited_last = 0;
