@@ -1,16 +1,22 @@
 // Parallel integration over blocks (MapParams::num_threads): the map, the per-scan figures and
 // the saved file are the same, byte for byte, for 1, 2 and 4 threads, for every policy and prior,
-// on random scans (with region clearing in between) and on the first 500 fr079 scans. Also the
-// make tsan target's core test of the parallel path.
+// on random scans (with region clearing in between) and on the first 500 fr079 scans; the scan's
+// preparation, shared with the workers, is the same field for field. Also the make tsan target's
+// core test of the parallel path.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "classify/prepared_scan.h"
 #include "test_support.h"
+#include "update/worker_pool.h"
+#include "wavog_mapping/core/wavelet_map.h"
 #include "wavog_mapping/io/carmen_reader.h"
 
 namespace wavog_test {
@@ -175,6 +181,92 @@ TEST(ParallelIntegration, RealDataFr079First500ScansGiveTheSameMapForOneTwoAndFo
       run.integrate(o, np.name + ", fr079 scan " + std::to_string(i));
     }
     run.expectSame("fr079_" + np.name);
+  }
+}
+
+// Every field the classifier reads, and the beam counts, of scans prepared on the calling thread
+// alone and with the help of 1 and 3 workers (pieces of 64 beams and the two tables, shared):
+// random scans (up to 3 pieces, every kind of reading), long ones (17 pieces) and refused ones,
+// with and without no-return clearing, a wide band and the reference's endpoints (NDT).
+TEST(ParallelIntegration, PreparedScanIsTheSameWithAndWithoutHelpers) {
+  using wavog::detail::PreparedScan;
+  wavog::detail::WorkerPool two(2), four(4);
+  for (int variant = 0; variant < 4; ++variant) {
+    MapParams p;
+    p.grid.resolution = 0.05;
+    p.sensor.no_return_clear = variant % 2 == 1 ? 6.0 : 0.0;
+    p.sensor.band_width = variant == 2 ? 0.3 : 0.0;
+    p.ndt = variant == 3;
+    RandomScans scans(17 + static_cast<std::uint32_t>(variant), 30.0);
+    for (int i = 0; i < 120; ++i) {
+      OwnedScan s = scans.next();
+      if (i % 4 == 3) {  // a long scan: the ranges repeated, over the same field of view
+        const double fov = s.angle_increment * static_cast<double>(s.ranges.size());
+        const std::vector<float> r = s.ranges;
+        s.ranges.clear();
+        while (s.ranges.size() < 1081) s.ranges.insert(s.ranges.end(), r.begin(), r.end());
+        s.ranges.resize(1081);
+        s.angle_increment = fov / 1081.0;
+      }
+      if (i == 50) s.ranges.assign(s.ranges.size(), std::numeric_limits<float>::quiet_NaN());
+      const std::string what = "variant " + std::to_string(variant) + ", scan " + std::to_string(i);
+      PreparedScan alone;
+      IntegrateStats st_alone;
+      wavog::ScanStatus status;
+      {
+        const wavog::detail::PrepareHelpers none(nullptr);
+        status = alone.prepare(p, s.pose, s.view(), &st_alone);
+      }
+      EXPECT_EQ(status == wavog::ScanStatus::kNoValidBeam, i == 50) << what;
+      if (status == wavog::ScanStatus::kOk) {
+        // The hit keys (merged from the pieces' sorted runs) and the invalid beams' prefix, as
+        // one thread computes them from the beams.
+        std::vector<std::uint64_t> keys;
+        std::vector<int> prefix{0};
+        for (std::size_t j = 0; j < alone.kind.size(); ++j) {
+          if (alone.kind[j] == wavog::detail::BeamKind::kHit) {
+            keys.push_back(PreparedScan::cellKey(alone.hit_x[j], alone.hit_y[j]));
+          }
+          prefix.push_back(prefix.back() + (alone.kind[j] == wavog::detail::BeamKind::kInvalid));
+        }
+        std::sort(keys.begin(), keys.end());
+        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+        EXPECT_TRUE(alone.hits == keys) << what;
+        EXPECT_TRUE(alone.invalid_prefix == prefix) << what;
+      }
+      for (wavog::detail::WorkerPool* pool : {&two, &four}) {
+        PreparedScan shared;
+        IntegrateStats st_shared;
+        {
+          const wavog::detail::PrepareHelpers helpers(pool);
+          ASSERT_EQ(shared.prepare(p, s.pose, s.view(), &st_shared), status) << what;
+        }
+        const std::string w = what + ", " + std::to_string(pool->threads()) + " threads";
+        EXPECT_EQ(st_alone.beams_hit, st_shared.beams_hit) << w;
+        EXPECT_EQ(st_alone.beams_no_return, st_shared.beams_no_return) << w;
+        EXPECT_EQ(st_alone.beams_invalid, st_shared.beams_invalid) << w;
+        EXPECT_EQ(st_alone.beams_beyond_limit, st_shared.beams_beyond_limit) << w;
+        if (status != wavog::ScanStatus::kOk) continue;
+        EXPECT_EQ(alone.reach, shared.reach) << w;
+        EXPECT_TRUE(alone.kind == shared.kind) << w;
+        EXPECT_TRUE(alone.hits == shared.hits) << w;
+        EXPECT_TRUE(alone.invalid_prefix == shared.invalid_prefix) << w;
+        EXPECT_TRUE(alone.min_e2 == shared.min_e2) << w;
+        EXPECT_TRUE(alone.max_u2 == shared.max_u2) << w;
+        EXPECT_TRUE(alone.bnd_x == shared.bnd_x && alone.bnd_y == shared.bnd_y) << w;
+        EXPECT_TRUE(alone.hit_x == shared.hit_x && alone.hit_y == shared.hit_y) << w;
+        EXPECT_TRUE(alone.hit_group == shared.hit_group && alone.hit_bit == shared.hit_bit) << w;
+        ASSERT_EQ(alone.leaf.size(), shared.leaf.size()) << w;
+        for (std::size_t j = 0; j < alone.leaf.size(); ++j) {
+          EXPECT_EQ(alone.leaf[j].e, shared.leaf[j].e) << w << ", beam " << j;
+          EXPECT_EQ(alone.leaf[j].o, shared.leaf[j].o) << w << ", beam " << j;
+          if (j < alone.kind.size() && alone.kind[j] == wavog::detail::BeamKind::kHit) {
+            EXPECT_EQ(alone.end_x[j], shared.end_x[j]) << w << ", beam " << j;
+            EXPECT_EQ(alone.end_y[j], shared.end_y[j]) << w << ", beam " << j;
+          }
+        }
+      }
+    }
   }
 }
 

@@ -2,14 +2,64 @@
 // limits per REP 117, hit cells, sector boundary directions and the min / max table.
 #include "classify/prepared_scan.h"
 
+#include <atomic>
 #include <limits>
 #include <type_traits>
 
+#include "update/worker_pool.h"
 #include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
 namespace detail {
+namespace {
+
+// The workers that help this thread's prepare() calls (PrepareHelpers).
+thread_local WorkerPool* t_helpers = nullptr;
+
+// Runs item(i) for every i in [0, items), on this thread and on the helpers that join, each
+// taking the next item from a shared counter (so this thread alone can take them all).
+template <typename Item>
+void forEachItem(std::size_t items, Item item) {
+  WorkerPool* pool = t_helpers;
+  if (pool == nullptr || pool->threads() <= 1 || items <= 1) {
+    for (std::size_t i = 0; i < items; ++i) item(i);
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  pool->run([&](int) {
+    for (std::size_t i = next.fetch_add(1, std::memory_order_relaxed); i < items;
+         i = next.fetch_add(1, std::memory_order_relaxed)) {
+      item(i);
+    }
+  });
+}
+
+// What a beam's reading says (REP 117): nothing (NaN, -inf, <= 0, below range_min), no return (at
+// or beyond sensor_max, +inf), or a return.
+enum class Reading : std::uint8_t { kNone, kNoReturn, kReturn };
+Reading readingOf(double z, double range_min, double sensor_max) {
+  if (std::isnan(z) || z == -std::numeric_limits<double>::infinity() || z <= 0.0 || z < range_min) {
+    return Reading::kNone;
+  }
+  return z >= sensor_max ? Reading::kNoReturn : Reading::kReturn;
+}
+// The beam's E limit and the end of its occupied band (m): +inf / -inf when it has none.
+void limitsOf(Reading r, double z, const BeamLimits& limits, double* ze, double* zu) {
+  *ze = std::numeric_limits<double>::infinity();
+  *zu = -std::numeric_limits<double>::infinity();
+  if (r == Reading::kReturn) {
+    *ze = z - limits.half_band;
+    *zu = z + limits.half_band;
+  } else if (r == Reading::kNoReturn && limits.clear > 0) {
+    *ze = *zu = limits.clear;
+  }
+}
+
+}  // namespace
+
+PrepareHelpers::PrepareHelpers(WorkerPool* pool) : previous_(t_helpers) { t_helpers = pool; }
+PrepareHelpers::~PrepareHelpers() { t_helpers = previous_; }
 
 ScanStatus checkScan(const Pose2& pose, const ScanView& scan) {
   if (scan.count == 0 || scan.ranges == nullptr) return ScanStatus::kEmpty;
@@ -45,16 +95,108 @@ ScanStatus PreparedScan::prepare(const MapParams& params, const Pose2& pose, con
   if (!reachInExtent(pose, limits, params.grid.resolution)) return ScanStatus::kOutOfExtent;
   const double cell = params.grid.resolution;
   setGeometry(pose, scan, cell);
-  setBoundaries();
   sectors.prepare(n, amin, inc);
   setUnits();
   exact_ends_ = params.ndt;  // the Gaussians take the endpoints as the reference computes them
-  setBeams(limits, scan, st);
-  if (invalid_prefix[static_cast<std::size_t>(n)] == n) return ScanStatus::kNoValidBeam;
-  std::sort(hits.begin(), hits.end());
-  hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
-  buildTables();
+  sizeBuffers();
+  // The per-beam work in pieces of kChunkBeams beams (their boundaries, endpoints, thresholds
+  // and sorted hit keys), then the two tables (each over all beams), shared with the helpers;
+  // every piece writes its own elements, so the result does not depend on who did which.
+  // The piece that finishes last also merges the pieces' hit keys and counts the invalid beams
+  // (while another participant may still build a table).
+  const auto nu = static_cast<std::size_t>(n);
+  const std::size_t chunks = (nu + kChunkBeams - 1) / kChunkBeams;
+  tallies_.assign(chunks, ChunkTally{});
+  runs_.resize(chunks);
+  std::atomic<std::size_t> finished{0};
+  forEachItem(chunks + 2, [&](std::size_t i) {
+    if (i >= chunks) {
+      buildTable(limits, scan.range_min, i == chunks);
+      return;
+    }
+    const std::size_t lo = i * kChunkBeams, hi = std::min(nu, lo + kChunkBeams);
+    setBoundaries(lo, i + 1 == chunks ? nu + 1 : hi);
+    setBeams(limits, scan.range_min, lo, hi, &tallies_[i]);
+    std::sort(hit_keys_.begin() + static_cast<std::ptrdiff_t>(lo),
+              hit_keys_.begin() + static_cast<std::ptrdiff_t>(lo + tallies_[i].hits));
+    // acq_rel: the last piece sees every other piece's keys and kinds.
+    if (finished.fetch_add(1, std::memory_order_acq_rel) + 1 < chunks) return;
+    mergeHits(chunks);
+    invalid_prefix[0] = 0;
+    for (std::size_t j = 0; j < nu; ++j) {
+      invalid_prefix[j + 1] = invalid_prefix[j] + (kind[j] == BeamKind::kInvalid ? 1 : 0);
+    }
+  });
+  reach = 0.0;
+  for (const ChunkTally& t : tallies_) {
+    st->beams_hit += t.hit;
+    st->beams_no_return += t.no_return;
+    st->beams_beyond_limit += t.beyond_limit;
+    st->beams_invalid += t.invalid;
+    reach = std::max(reach, t.reach);
+  }
+  if (invalid_prefix[nu] == n) return ScanStatus::kNoValidBeam;
   return ScanStatus::kOk;
+}
+
+void PreparedScan::sizeBuffers() {
+  // Every element is written by setBoundaries(), setBeams() or buildTable() (a resize to the same
+  // size touches nothing).
+  const auto nu = static_cast<std::size_t>(n);
+  bnd_x.resize(nu + 1);
+  bnd_y.resize(nu + 1);
+  kind.resize(nu);
+  leaf.resize(nu + 1);
+  leaf[nu] = LeafTest{};  // outside the fan: never E, never O
+  hit_x.resize(nu);
+  hit_y.resize(nu);
+  hit_group.resize(nu);
+  hit_bit.resize(nu);
+  end_x.resize(nu);  // written for the hit beams only
+  end_y.resize(nu);
+  hit_keys_.resize(nu);
+  hits.resize(nu);  // mergeHits() writes at most nu keys
+  invalid_prefix.resize(nu + 1);
+  const std::size_t size = static_cast<std::size_t>(tableLevels()) * nu;
+  min_e2.resize(size);
+  max_u2.resize(size);
+  group_x0 = static_cast<std::int64_t>(std::floor(px / res)) >> 2;
+  group_y0 = static_cast<std::int64_t>(std::floor(py / res)) >> 2;
+}
+
+void PreparedScan::mergeHits(std::size_t chunks) {
+  // The pieces' sorted runs of hit keys, merged pairwise (hit_keys_ and hits taking turns as the
+  // source), then made unique: the same as sorting all of them.
+  std::vector<std::pair<std::size_t, std::size_t>>& runs = runs_;  // [begin, end)
+  runs.resize(chunks);  // sized by prepare(): no allocation here
+  std::size_t total = 0;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    runs[c] = {c * kChunkBeams, c * kChunkBeams + tallies_[c].hits};
+    total += tallies_[c].hits;
+  }
+  std::vector<std::uint64_t>* from = &hit_keys_;
+  std::vector<std::uint64_t>* to = &hits;
+  do {
+    const std::uint64_t* in = from->data();
+    std::uint64_t* const out = to->data();
+    std::uint64_t* end = out;
+    std::size_t merged = 0;
+    for (std::size_t r = 0; r < runs.size(); r += 2) {
+      std::uint64_t* const begin = end;
+      if (r + 1 < runs.size()) {
+        end = std::merge(in + runs[r].first, in + runs[r].second, in + runs[r + 1].first,
+                         in + runs[r + 1].second, end);
+      } else {
+        end = std::copy(in + runs[r].first, in + runs[r].second, end);
+      }
+      runs[merged++] = {static_cast<std::size_t>(begin - out), static_cast<std::size_t>(end - out)};
+    }
+    runs.resize(merged);
+    std::swap(from, to);
+  } while (runs.size() > 1);
+  if (from != &hits) hits.swap(hit_keys_);  // the merged keys end in `hits`
+  hits.resize(total);
+  hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
 }
 
 void PreparedScan::setGeometry(const Pose2& pose, const ScanView& scan, double resolution) {
@@ -83,17 +225,16 @@ void PreparedScan::setGeometry(const Pose2& pose, const ScanView& scan, double r
   t_seam = (seam - amin) / inc;
 }
 
-void PreparedScan::setBoundaries() {
-  const auto nu = static_cast<std::size_t>(n);
-  bnd_x.resize(nu + 1);
-  bnd_y.resize(nu + 1);
+void PreparedScan::setBoundaries(std::size_t lo, std::size_t hi) {
   // Boundary k points along theta + amin + (k - 1/2) inc. Rotating by inc from a direction
   // computed with sin and cos every kBoundaryAnchor boundaries spares a sin and a cos per beam;
   // it drifts by under 1e-12 rad (4e-13 worst, measured for steps from 1e-6 to 2.1 rad), far
-  // inside kRayMargin.
+  // inside kRayMargin. A range starts at an anchor (kChunkBeams is a multiple of it), so the
+  // boundaries are the same however the ranges are cut.
   constexpr std::size_t kBoundaryAnchor = 64;
+  static_assert(kChunkBeams % kBoundaryAnchor == 0, "pieces start at an anchor");
   const double step_c = std::cos(inc), step_s = std::sin(inc);
-  for (std::size_t k = 0; k <= nu; ++k) {
+  for (std::size_t k = lo; k < hi; ++k) {
     if (k % kBoundaryAnchor == 0) {
       const double b = theta + amin + (static_cast<double>(k) - 0.5) * inc;
       bnd_x[k] = std::cos(b);
@@ -122,52 +263,32 @@ BeamLimits beamLimits(const MapParams& params, const ScanView& scan) {
   return limits;
 }
 
-void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, IntegrateStats* st) {
-  const auto nu = static_cast<std::size_t>(n);
-  const double sensor_max = limits.sensor_max;
-  const double half_band = limits.half_band;
-  const double clear = limits.clear;
-  const double inf = std::numeric_limits<double>::infinity();
-  kind.assign(nu, BeamKind::kInvalid);
-  leaf.resize(nu + 1);    // every element is written below
-  leaf[nu] = LeafTest{};  // outside the fan: never E, never O
-  // Level 0 of the tables is written below, the levels above by buildTables(). Sized once per
-  // scan without clearing (a resize to the same size touches nothing).
-  tableLevels();
-  invalid_prefix.assign(nu + 1, 0);
-  hits.clear();
-  hit_x.assign(nu, 0);
-  hit_y.assign(nu, 0);
-  hit_group.assign(nu, 0);
-  hit_bit.assign(nu, 0);
-  group_x0 = static_cast<std::int64_t>(std::floor(px / res)) >> 2;
-  group_y0 = static_cast<std::int64_t>(std::floor(py / res)) >> 2;
-  end_x.resize(nu);  // written for the hit beams below
-  end_y.resize(nu);
-  reach = 0.0;
+void PreparedScan::setBeams(const BeamLimits& limits, double range_min, std::size_t lo,
+                            std::size_t hi, ChunkTally* tally) {
   // The rotated endpoint differs from the reference's by under 2^-53 (|theta| + |bearing|) z for
   // the rounding of theta + bearing plus a few ulps of |p| + z (cos, sin, products; 1e-15 each
   // bounds them): a guard of 1e-12 of those, in cells, around a cell edge leaves a 1000-fold
   // margin.
   const double angle_scale = std::fabs(theta) + std::fabs(amin) + 8.0;
   const double end_offset = std::fabs(px) + std::fabs(py);
-  for (std::size_t j = 0; j < nu; ++j) {
+  std::uint64_t* keys = hit_keys_.data() + lo;
+  for (std::size_t j = lo; j < hi; ++j) {
     const double z = ranges_[j];
-    double ze = inf, zu = -inf;  // E limit and end of the occupied band (m)
-    if (std::isnan(z) || z == -inf || z <= 0.0 || z < scan.range_min) {
-      ++st->beams_invalid;
-    } else if (z >= sensor_max) {  // +inf and out-of-range readings: no return (REP 117)
-      ++st->beams_no_return;
-      if (z < limits.given) ++st->beams_beyond_limit;  // a return but for the hard limit
-      if (clear > 0) {
-        kind[j] = BeamKind::kClear;
-        ze = zu = clear;
-      }
+    const Reading r = readingOf(z, range_min, limits.sensor_max);
+    double ze, zu;  // E limit and end of the occupied band (m)
+    limitsOf(r, z, limits, &ze, &zu);
+    BeamKind k = BeamKind::kInvalid;
+    hit_x[j] = hit_y[j] = 0;
+    hit_group[j] = hit_bit[j] = 0;
+    if (r == Reading::kNone) {
+      ++tally->invalid;
+    } else if (r == Reading::kNoReturn) {  // +inf and out-of-range readings (REP 117)
+      ++tally->no_return;
+      if (z < limits.given) ++tally->beyond_limit;  // a return but for the hard limit
+      if (limits.clear > 0) k = BeamKind::kClear;
     } else {
-      ++st->beams_hit;
-      kind[j] = BeamKind::kHit;
-      ze = z - half_band;
-      zu = z + half_band;
+      ++tally->hit;
+      k = BeamKind::kHit;
       // The endpoint from the beam's unit vector rotated by the pose (a few ulps from the
       // reference's cos / sin of theta + bearing); the reference's own arithmetic when its
       // cell could differ, or when the endpoint itself is used (exact_ends_).
@@ -188,17 +309,15 @@ void PreparedScan::setBeams(const BeamLimits& limits, const ScanView& scan, Inte
       end_y[j] = ey;
       hit_x[j] = static_cast<std::int64_t>(fx);
       hit_y[j] = static_cast<std::int64_t>(fy);
-      hits.push_back(cellKey(hit_x[j], hit_y[j]));
+      keys[tally->hits++] = cellKey(hit_x[j], hit_y[j]);
       hit_group[j] = groupKey(hit_x[j], hit_y[j]);
       hit_bit[j] = 1u << ((hit_x[j] & 3) + 4 * (hit_y[j] & 3));
     }
-    const bool valid = kind[j] != BeamKind::kInvalid;
-    min_e2[j] = squaredLimit(ze);
-    max_u2[j] = squaredLimit(zu);
+    kind[j] = k;
+    const bool valid = k != BeamKind::kInvalid;
     leaf[j].e = valid ? sqrtBelow(ze) : -1.0;
-    leaf[j].o = kind[j] == BeamKind::kHit ? sqrtAtMost(zu) : -1.0;
-    if (valid) reach = std::max(reach, zu);
-    invalid_prefix[j + 1] = invalid_prefix[j] + (valid ? 0 : 1);
+    leaf[j].o = k == BeamKind::kHit ? sqrtAtMost(zu) : -1.0;
+    if (valid) tally->reach = std::max(tally->reach, zu);
   }
 }
 
@@ -217,26 +336,42 @@ void PreparedScan::setUnits() {
   units_inc_ = inc;
 }
 
-int PreparedScan::tableLevels() {
+int PreparedScan::tableLevels() const {
   int levels = 1;
   while ((1 << levels) <= n) ++levels;
-  const std::size_t size = static_cast<std::size_t>(levels) * static_cast<std::size_t>(n);
-  min_e2.resize(size);
-  max_u2.resize(size);
   return levels;
 }
 
-void PreparedScan::buildTables() {
-  // Level k holds min / max over [j, j + 2^k); level 0 is filled by setBeams().
+void PreparedScan::buildTable(const BeamLimits& limits, double range_min, bool empty) {
+  // Level 0: each beam's squared limit (E limit or end of the occupied band); level k holds the
+  // min / max over [j, j + 2^k).
   const auto nu = static_cast<std::size_t>(n);
-  const int levels = tableLevels();
-  for (int k = 1; k < levels; ++k) {
-    const std::size_t base = static_cast<std::size_t>(k) * nu, prev = base - nu;
-    const std::size_t half = std::size_t{1} << (k - 1);
-    for (std::size_t j = 0; j + (std::size_t{1} << k) <= nu; ++j) {
-      min_e2[base + j] = std::min(min_e2[prev + j], min_e2[prev + j + half]);
-      max_u2[base + j] = std::max(max_u2[prev + j], max_u2[prev + j + half]);
+  double* t = empty ? min_e2.data() : max_u2.data();
+  // limitsOf(readingOf(z)) as selects (NaN and -inf fail z > 0): no branch per beam.
+  const double none =
+      empty ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+  const double band = empty ? -limits.half_band : limits.half_band;
+  const double no_return = limits.clear > 0 ? limits.clear : none;
+  for (std::size_t j = 0; j < nu; ++j) {
+    const double z = ranges_[j];
+    const bool reading = z > 0.0 && z >= range_min;
+    const double limit = reading ? (z < limits.sensor_max ? z + band : no_return) : none;
+    t[j] = squaredLimit(limit);
+  }
+  const auto levelsBy = [&](auto pick) {
+    const int levels = tableLevels();
+    for (int k = 1; k < levels; ++k) {
+      const std::size_t base = static_cast<std::size_t>(k) * nu, prev = base - nu;
+      const std::size_t half = std::size_t{1} << (k - 1);
+      for (std::size_t j = 0; j + (std::size_t{1} << k) <= nu; ++j) {
+        t[base + j] = pick(t[prev + j], t[prev + j + half]);
+      }
     }
+  };
+  if (empty) {
+    levelsBy([](double a, double b) { return std::min(a, b); });
+  } else {
+    levelsBy([](double a, double b) { return std::max(a, b); });
   }
 }
 
@@ -255,6 +390,9 @@ void PreparedScan::releaseIfLarge() {
   release(end_y);
   release(hit_y);
   release(hits);
+  release(hit_keys_);
+  release(tallies_);
+  release(runs_);
   release(invalid_prefix);
   release(min_e2);
   release(max_u2);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "classify/scan_numerics.h"
@@ -20,6 +21,22 @@ namespace wavog {
 struct IntegrateStats;
 
 namespace detail {
+
+class WorkerPool;  // update/worker_pool.h
+
+/// While it lives, PreparedScan::prepare() on this thread shares its per-beam work (endpoints,
+/// thresholds, boundaries, the min / max tables) with the workers of `pool` (integrate.cpp: the
+/// map's threads; nullptr: none). They only help: the result is the same with or without them.
+class PrepareHelpers {
+ public:
+  explicit PrepareHelpers(WorkerPool* pool);
+  ~PrepareHelpers();
+  PrepareHelpers(const PrepareHelpers&) = delete;
+  PrepareHelpers& operator=(const PrepareHelpers&) = delete;
+
+ private:
+  WorkerPool* previous_;
+};
 
 /// A beam per REP 117: no information, a return (hit), or a no-return that clears free space.
 enum class BeamKind : std::uint8_t { kInvalid, kHit, kClear };
@@ -151,15 +168,31 @@ struct PreparedScan {
  private:
   /// releaseIfLarge() frees a pseudo-bearing table of more buckets (a beam step under 1e-3 rad).
   static constexpr std::size_t kKeepBuckets = 8192;
+  /// Beams per piece of the shared per-beam work (a multiple of setBoundaries' anchor step).
+  static constexpr std::size_t kChunkBeams = 64;
+  /// What the beams of one piece counted (IntegrateStats), their hits and their reach.
+  struct ChunkTally {
+    std::uint32_t hit = 0, no_return = 0, beyond_limit = 0, invalid = 0;
+    std::size_t hits = 0;  // hit keys, sorted, from hit_keys_[first beam]
+    double reach = 0.0;
+  };
   void setGeometry(const Pose2& pose, const ScanView& scan, double res);
-  void setBoundaries();
-  void setBeams(const BeamLimits& limits, const ScanView& scan, IntegrateStats* st);
+  void sizeBuffers();
+  void setBoundaries(std::size_t lo, std::size_t hi);  // boundaries [lo, hi)
+  void setBeams(const BeamLimits& limits, double range_min, std::size_t lo, std::size_t hi,
+                ChunkTally* tally);  // beams [lo, hi)
   /// The beams' sensor-frame unit vectors, kept while the geometry (n, amin, inc) is.
   void setUnits();
-  void buildTables();
-  int tableLevels();  // sizes the tables for n beams; returns their levels
+  /// min_e2 (empty) or max_u2, every level.
+  void buildTable(const BeamLimits& limits, double range_min, bool empty);
+  void mergeHits(std::size_t chunks);
+  int tableLevels() const;  // levels of the tables for n beams
 
   std::vector<float> ranges_;            // work copy, in ascending bearing order
+  std::vector<std::uint64_t> hit_keys_;  // per piece, from its first beam: its hit keys, sorted
+  std::vector<ChunkTally> tallies_;      // per piece
+  // mergeHits(): runs of sorted keys, [begin, end)
+  std::vector<std::pair<std::size_t, std::size_t>> runs_;
   std::vector<double> unit_c_, unit_s_;  // cos / sin of amin + j inc
   int units_n_ = -1;                     // the geometry they hold
   double units_amin_ = 0, units_inc_ = 0;

@@ -86,7 +86,10 @@ template <PolicyType P>
   const std::size_t n = plan->parts.size();
   for (std::size_t i = next->fetch_add(1, std::memory_order_relaxed); i < n;
        i = next->fetch_add(1, std::memory_order_relaxed)) {
-    integrator.visitPart(&plan->tasks[plan->parts[i]]);
+    SplitTask& t = plan->tasks[plan->parts[i]];
+    const std::uint64_t before = integrator.visited();
+    integrator.visitPart(&t);
+    t.visits = integrator.visited() - before;
   }
   return integrator.visited();
 }

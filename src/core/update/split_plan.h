@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "classify/scan_classifier.h"
@@ -53,13 +54,18 @@ struct SplitTask {
   std::int64_t ix0 = 0, iy0 = 0;
   double s = 0.0;
   std::uint32_t* spare = nullptr;  ///< its spare list (NodePool::pushSpare)
+  std::uint64_t visits = 0;        ///< the nodes its update visited (updateParts)
 };
 
 /// The tasks of one scan's split blocks, in the planning's (depth-first) order, and the indices
-/// of its parts.
+/// of its parts; and what the parts of the last parallel scan cost.
 struct SplitPlan {
   std::vector<SplitTask> tasks;
   std::vector<std::size_t> parts;
+  /// The last parallel scan's parts, sorted: their spare list's address (a block's part) and
+  /// their visits, which predict what the same part costs in the next scan (the order of the
+  /// parts, integrate.cpp). Kept by clear().
+  std::vector<std::pair<std::uintptr_t, std::uint64_t>> last_visits;
   void clear() {
     tasks.clear();
     parts.clear();
