@@ -2,6 +2,7 @@
 // core (F1-F5, H1) as a test, plus the limits around them (block keys that would alias, beams
 // beyond the hard range limit, scratch buffers, read-out sizes).
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -73,7 +74,7 @@ std::string writeFarApart(const std::string& name, std::int32_t a, std::int32_t 
   }
   const auto crc = static_cast<std::uint32_t>(crc32(0L, f.data(), static_cast<uInt>(f.size())));
   put(&crc, 4);
-  const std::string path = ::testing::TempDir() + name;
+  const std::string path = ::testing::TempDir() + std::to_string(::getpid()) + "_" + name;
   std::ofstream(path, std::ios::binary)
       .write(reinterpret_cast<const char*>(f.data()), static_cast<std::streamsize>(f.size()));
   return path;

@@ -4,6 +4,7 @@
 // preparation, shared with the workers, is the same field for field. Also the make tsan target's
 // core test of the parallel path.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <fstream>
@@ -30,7 +31,9 @@ using wavog::WaveletMap;
 constexpr int kThreadCounts[] = {1, 2, 4};
 
 std::vector<char> savedBytes(const WaveletMap& map, const std::string& name) {
-  const std::string path = ::testing::TempDir() + "wavog_parallel_" + name + ".wavog";
+  // Per process: the same test run beside it (another build, a sanitizer run) writes its own.
+  const std::string path =
+      ::testing::TempDir() + "wavog_parallel_" + std::to_string(::getpid()) + "_" + name + ".wavog";
   map.save(path);
   std::ifstream in(path, std::ios::binary);
   std::vector<char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
