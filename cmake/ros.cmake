@@ -132,6 +132,10 @@ if(CATKIN_ENABLE_TESTING)
       wavog_rostest_gtest(test_bad_input test/bad_input.test test/ros/test_bad_input.cpp)
     endif()
 
+    # Scans waiting for late tf: pushed out of the tf filter, placed when tf comes, dropped only at
+    # the bounds (subscriber_queue_size, tf_cache_time).
+    wavog_rostest_gtest(test_tf_wait test/tf_wait.test test/ros/test_tf_wait.cpp)
+
     # Lost scans: seq gaps counted exactly, seq 0 not counted, a burst fully accounted for.
     wavog_rostest_gtest(test_lost_scans test/ros/lost_scans.test test/ros/test_lost_scans.cpp)
 

@@ -101,6 +101,7 @@ MappingRos::Impl::~Impl() {
   diag_timer_.stop();
   idle_timer_.stop();
   silent_timer_.stop();
+  retry_timer_.stop();
   tf_sub_.shutdown();
   tf_static_sub_.shutdown();
   for (auto& in : inputs_) in->sub.shutdown();
@@ -222,6 +223,11 @@ void MappingRos::Impl::startTimers() {
     silent_timer_ = nh_.createWallTimer(
         ros::WallDuration(kSilentInputPeriod), [this](const ros::WallTimerEvent&) {
           guarded("silent input timer", nullptr, [&] { warnSilentInputs(); });
+        });
+    // Wall time, as the tf that places the waiting scans may come with the ROS clock stopped.
+    retry_timer_ =
+        nh_.createWallTimer(ros::WallDuration(kRetryPeriod), [this](const ros::WallTimerEvent& e) {
+          guarded("tf retry timer", nullptr, [&] { onRetryTimer(e); });
         });
   }
   if (rp.idle_timeout > 0.0) {

@@ -59,6 +59,7 @@ std::size_t MappingRos::Impl::flushPending() {
     for (auto& in : inputs_) {
       for (auto& p : in->pending) waiting.emplace_back(in.get(), std::move(p));
       in->pending.clear();
+      in->outside = 0;
     }
   }
   // No newer tf is coming: the scan is placed by the newest transform of its frame, without

@@ -57,6 +57,8 @@ using ScanFilter = tf2_ros::MessageFilter<sensor_msgs::LaserScan>;
 constexpr double kWarnPeriod = 5.0;
 /// Wall seconds between the console warnings about an input nothing publishes (warnSilentInputs).
 constexpr double kSilentInputPeriod = 10.0;
+/// Wall seconds between two tries to place the scans pushed out of the tf filter (onRetryTimer).
+constexpr double kRetryPeriod = 0.1;
 /// Warning slots of an input (Input::last_warn) after one per drop reason.
 enum WarningSlot : std::size_t {
   kOtherWarning = kNumDropReasons,  ///< time jumps and motion fallbacks
@@ -71,6 +73,9 @@ struct PendingScan {
   sensor_msgs::LaserScan::ConstPtr scan;
   bool placed = false;  ///< out of the filter: `placement` holds what tf said (or its failure)
   ScanPlacement placement;  ///< valid when `placed`
+  /// Pushed out of the full tf filter (more than queue_size scans waiting for tf): waits here,
+  /// placed by releaseReadyLocked once tf covers its stamp (Input::outside counts these).
+  bool outside = false;
 };
 
 /// One LaserScan input: its subscription, its tf filter and its counters.
@@ -93,10 +98,12 @@ struct Input {
   /// Scans handed to the tf filter and not yet integrated, dropped or flushed, in the order they
   /// were received; whoever removes a scan from here owns it. Guarded by Impl::mutex_. The filter
   /// hands scans on from several threads in any order; they are integrated from the front only,
-  /// so in the order received, as wavog_offline does (issue 42). At most 2 x queue_size long: the
-  /// filter reports every scan it drops, and a scan that holds up more than queue_size placed ones
-  /// is dropped (releaseReadyLocked).
+  /// so in the order received, as wavog_offline does (issue 42). At most 2 x queue_size +
+  /// subscriber_queue_size long: the filter holds at most queue_size; a scan it pushes out waits
+  /// here (`outside`) only while tf connects its frame, and at most subscriber_queue_size of those;
+  /// a scan that holds up more than queue_size placed ones is dropped (releaseReadyLocked).
   std::deque<PendingScan> pending;
+  std::size_t outside = 0;  ///< entries of `pending` with `outside` set (Impl::mutex_)
 };
 
 struct MappingRos::Impl {
@@ -132,8 +139,15 @@ struct MappingRos::Impl {
   /// The entry of `scan` in in->pending; null if it is not there (flushed or already handled).
   PendingScan* findPendingLocked(Input* in, const sensor_msgs::LaserScan* scan);
   /// Integrates (or drops) the placed scans at the front of in->pending, in the order received,
-  /// up to the first one still waiting for tf. Returns how many left the queue.
+  /// up to the first one still waiting for tf; a scan pushed out of the filter at the front is
+  /// placed here once tf covers it. Returns how many left the queue.
   std::size_t releaseReadyLocked(Input* in);
+  /// Why the scan at the front of in->pending, pushed out of the filter and not yet placeable,
+  /// must be dropped now (`reason` set), or empty: it goes on waiting for tf.
+  std::string outsideDropLocked(Input* in, DropReason* reason);
+  /// Wall timer (retry_timer_): places the scans pushed out of the filter that tf now covers,
+  /// when no other scan of their input comes to do it (the end of a bag, tf in one late burst).
+  void onRetryTimer(const ros::WallTimerEvent&);
   /// A scan tf has placed (or failed to): dropped, or integrated with its placement.
   void integratePlacedScanLocked(Input* in, const sensor_msgs::LaserScan& scan,
                                  const ScanPlacement& placement);
@@ -251,7 +265,8 @@ struct MappingRos::Impl {
 
   ros::Publisher status_pub_;
   ros::ServiceServer reset_srv_, clear_srv_, save_srv_, flush_srv_, dynamic_map_srv_;
-  ros::WallTimer publish_timer_, update_timer_, diag_timer_, idle_timer_, silent_timer_;
+  ros::WallTimer publish_timer_, update_timer_, diag_timer_, idle_timer_, silent_timer_,
+      retry_timer_;
   /// Serialises publications (publishAll, onUpdateTimer): taken before mutex_, never inside it.
   std::mutex publish_mutex_;
   bool windowed_warned_ = false;  ///< the fallback-window message was given (publish_mutex_)

@@ -204,7 +204,30 @@ void MappingRos::Impl::onFilterFailure(
   const auto it = std::find_if(pending.begin(), pending.end(),
                                [&scan](const PendingScan& p) { return p.scan == scan; });
   if (it == pending.end()) return;  // already flushed
+  // Pushed out of the full filter (more than queue_size scans waiting: tf late, e.g. a loaded
+  // host, or not yet there at start-up): it waits in its turn, placed once tf covers it
+  // (releaseReadyLocked), so that how late tf comes does not change the map. A frame tf does not
+  // connect (yet) is named at once; its scans are dropped when later ones are placed, or at the
+  // memory bound (outsideDropLocked).
+  if (reason == tf2_ros::filter_failure_reasons::Unknown) {
+    if (!it->outside) {
+      it->outside = true;
+      ++in->outside;
+    }
+    if (!buffer_->canTransform(placement_.fixed_frame, scan->header.frame_id, ros::Time(0))) {
+      warnLocked(in, kOtherWarning,
+                 "more than queue_size " + std::to_string(config_.ros.queue_size) +
+                     " scans waiting for tf, and " +
+                     noTransformText(*buffer_, scan->header.frame_id, placement_.fixed_frame,
+                                     config_.ros.queue_size) +
+                     " (the scans wait for tf up to subscriber_queue_size " +
+                     std::to_string(config_.ros.subscriber_queue_size) + ")");
+    }
+    releaseReadyLocked(in);
+    return;
+  }
   // Dropped now, not in its turn: a drop changes no map, so its order does not matter.
+  if (it->outside) --in->outside;
   pending.erase(it);
   if (reason == tf2_ros::filter_failure_reasons::OutTheBack) {
     dropLocked(in, DropReason::kTfTooOld, "stamp older than the tf buffer");
@@ -246,29 +269,115 @@ PendingScan* MappingRos::Impl::findPendingLocked(Input* in, const sensor_msgs::L
 std::size_t MappingRos::Impl::releaseReadyLocked(Input* in) {
   auto& p = in->pending;
   std::size_t n = 0;
+  const ros::Duration tolerance(config_.ros.tf_tolerance);
+  const auto transformable = [&](const PendingScan& s) {
+    const std_msgs::Header& h = s.scan->header;
+    return buffer_->canTransform(placement_.fixed_frame, h.frame_id, h.stamp) &&
+           buffer_->canTransform(placement_.fixed_frame, h.frame_id, h.stamp + tolerance);
+  };
   // A scan tf cannot place while more than queue_size scans behind it are placed (tf for its
   // frame alone missing; the filter, holding only it, never overflows) no longer holds them up.
   // One that tf can place is on its way here (a spinner thread between the filter and
-  // onTransformable), however long its thread is descheduled: it is waited for.
+  // onTransformable), however long its thread is descheduled: it is waited for. The scans pushed
+  // out of the filter are not counted: they wait here for tf, not for a thread.
   const std::size_t limit = 2 * static_cast<std::size_t>(config_.ros.queue_size);
-  while (!p.empty() && !p.front().placed && p.size() > limit &&
-         !buffer_->canTransform(
-             placement_.fixed_frame, p.front().scan->header.frame_id,
-             p.front().scan->header.stamp + ros::Duration(config_.ros.tf_tolerance))) {
-    p.pop_front();
-    ++n;
-    dropLocked(in, DropReason::kTfUnavailable,
-               "no transform to '" + placement_.fixed_frame + "' while " +
-                   std::to_string(config_.ros.queue_size) +
-                   " (queue_size) later scans were placed");
-  }
-  while (!p.empty() && p.front().placed) {
-    const PendingScan next = std::move(p.front());
-    p.pop_front();
-    ++n;
-    integratePlacedScanLocked(in, *next.scan, next.placement);
+  while (!p.empty()) {
+    PendingScan& front = p.front();
+    if (front.placed) {
+      const PendingScan next = std::move(front);
+      p.pop_front();
+      ++n;
+      integratePlacedScanLocked(in, *next.scan, next.placement);
+      continue;
+    }
+    if (front.outside) {
+      // Placed here as the filter would have placed it: tf covers its stamp + tf_tolerance.
+      if (transformable(front)) {
+        front.placement = placeScan(*buffer_, *front.scan, placement_);
+        front.placed = true;
+        front.outside = false;
+        --in->outside;
+        continue;
+      }
+      DropReason reason{};
+      const std::string why = outsideDropLocked(in, &reason);
+      if (why.empty()) break;
+      p.pop_front();
+      --in->outside;
+      ++n;
+      dropLocked(in, reason, why);
+      continue;
+    }
+    if (p.size() - in->outside > limit &&
+        !buffer_->canTransform(placement_.fixed_frame, front.scan->header.frame_id,
+                               front.scan->header.stamp + tolerance)) {
+      p.pop_front();
+      ++n;
+      dropLocked(in, DropReason::kTfUnavailable,
+                 "no transform to '" + placement_.fixed_frame + "' while " +
+                     std::to_string(config_.ros.queue_size) +
+                     " (queue_size) later scans were placed");
+      continue;
+    }
+    break;
   }
   return n;
+}
+
+std::string MappingRos::Impl::outsideDropLocked(Input* in, DropReason* reason) {
+  const auto& p = in->pending;
+  const sensor_msgs::LaserScan& scan = *p.front().scan;
+  const std::string& frame = scan.header.frame_id;
+  const std::string& fixed = placement_.fixed_frame;
+  const int queue_size = config_.ros.queue_size;
+  *reason = DropReason::kTfUnavailable;
+  const bool connected = buffer_->canTransform(fixed, frame, ros::Time(0));
+  ros::Time newest;  // of the transforms between the frames (zero: static ones only)
+  if (connected) {
+    try {
+      newest = buffer_->lookupTransform(fixed, frame, ros::Time(0)).header.stamp;
+    } catch (const tf2::TransformException&) {
+      // tf cleared meanwhile (a clock jump): nothing newer to compare with.
+    }
+  }
+  // As for the scans in the filter (releaseReadyLocked): tf for its frame alone missing.
+  const auto placed =
+      std::count_if(p.begin(), p.end(), [](const PendingScan& s) { return s.placed; });
+  if (placed > queue_size) {
+    if (!connected) return noTransformText(*buffer_, frame, fixed, queue_size);
+    return "no transform to '" + fixed + "' while " + std::to_string(queue_size) +
+           " (queue_size) later scans were placed";
+  }
+  // tf can no longer place it: the newest transform between the frames is more than the buffer's
+  // length (tf_cache_time) after the scan, so the one at its stamp is gone or never comes.
+  if (connected && newest > scan.header.stamp &&
+      (newest - scan.header.stamp).toSec() > config_.ros.tf_cache_time) {
+    *reason = DropReason::kTfTooOld;
+    std::ostringstream text;
+    text << "stamp older than the tf buffer (tf_cache_time " << config_.ros.tf_cache_time
+         << " s) before tf covered it: it waited for tf with more than queue_size " << queue_size
+         << " scans";
+    return text.str();
+  }
+  // The memory bound: as many scans waiting for tf as roscpp may hold for the input.
+  const auto bound = static_cast<std::size_t>(config_.ros.subscriber_queue_size);
+  if (in->outside <= bound) return "";
+  if (!connected) return noTransformText(*buffer_, frame, fixed, queue_size);
+  return "no transform from '" + frame + "' to '" + fixed +
+         "' at the scan's stamp while more than " + std::to_string(bound) +
+         " (subscriber_queue_size) scans beyond the tf filter's " + std::to_string(queue_size) +
+         " (queue_size) waited for tf: tf is that late, or stopped";
+}
+
+void MappingRos::Impl::onRetryTimer(const ros::WallTimerEvent&) {
+  std::size_t released = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& in : inputs_) {
+      if (in->outside > 0) released += releaseReadyLocked(in.get());
+    }
+  }
+  if (released > 0 && fleet_stream_) fleet_stream_->publishQueued();  // without the lock
 }
 
 void MappingRos::Impl::integratePlacedScanLocked(Input* in, const sensor_msgs::LaserScan& scan,
