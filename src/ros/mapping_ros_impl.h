@@ -144,6 +144,8 @@ struct MappingRos::Impl {
   std::size_t releaseReadyLocked(Input* in);
   /// Why the scan at the front of in->pending, pushed out of the filter and not yet placeable,
   /// must be dropped now (`reason` set), or empty: it goes on waiting for tf.
+  /// The drop message of a scan tf cannot place while more than queue_size later ones are placed.
+  std::string laterScansPlacedText() const;
   std::string outsideDropLocked(Input* in, DropReason* reason);
   /// Wall timer (retry_timer_): places the scans pushed out of the filter that tf now covers,
   /// when no other scan of their input comes to do it (the end of a bag, tf in one late burst).

@@ -313,15 +313,17 @@ std::size_t MappingRos::Impl::releaseReadyLocked(Input* in) {
                                front.scan->header.stamp + tolerance)) {
       p.pop_front();
       ++n;
-      dropLocked(in, DropReason::kTfUnavailable,
-                 "no transform to '" + placement_.fixed_frame + "' while " +
-                     std::to_string(config_.ros.queue_size) +
-                     " (queue_size) later scans were placed");
+      dropLocked(in, DropReason::kTfUnavailable, laterScansPlacedText());
       continue;
     }
     break;
   }
   return n;
+}
+
+std::string MappingRos::Impl::laterScansPlacedText() const {
+  return "no transform to '" + placement_.fixed_frame + "' while " +
+         std::to_string(config_.ros.queue_size) + " (queue_size) later scans were placed";
 }
 
 std::string MappingRos::Impl::outsideDropLocked(Input* in, DropReason* reason) {
@@ -345,8 +347,7 @@ std::string MappingRos::Impl::outsideDropLocked(Input* in, DropReason* reason) {
       std::count_if(p.begin(), p.end(), [](const PendingScan& s) { return s.placed; });
   if (placed > queue_size) {
     if (!connected) return noTransformText(*buffer_, frame, fixed, queue_size);
-    return "no transform to '" + fixed + "' while " + std::to_string(queue_size) +
-           " (queue_size) later scans were placed";
+    return laterScansPlacedText();
   }
   // tf can no longer place it: the newest transform between the frames is more than the buffer's
   // length (tf_cache_time) after the scan, so the one at its stamp is gone or never comes.

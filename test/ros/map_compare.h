@@ -1,5 +1,5 @@
 // Comparing two maps' rasters of one box bit for bit, shared by the fleet's tests
-// (test_fleet_merge.cpp, test_fleet_system.cpp, test_fleet_shards.cpp).
+// (test_fleet_merge.cpp, test_fleet_system.cpp, test_fleet_shards.cpp, test_fleet_lagging.cpp).
 #ifndef WAVOG_MAPPING_TEST_ROS_MAP_COMPARE_H_
 #define WAVOG_MAPPING_TEST_ROS_MAP_COMPARE_H_
 
@@ -19,6 +19,21 @@ inline std::size_t differingCells(const wavog::Raster& a, const wavog::Raster& b
               std::memcmp(&a.log_odds[i], &b.log_odds[i], sizeof(float)) != 0;
   }
   return differ;
+}
+
+/// The finest rasters of maps `a` and `b` over their bounds, when both hold cells and their bounds
+/// are the same (else false).
+inline bool finestRasters(const wavog::WaveletMap& a, const wavog::WaveletMap& b, wavog::Raster* ra,
+                          wavog::Raster* rb) {
+  wavog::CellBox ba, bb;
+  if (!a.bounds(0, &ba) || !b.bounds(0, &bb)) return false;
+  if (ba.min_x != bb.min_x || ba.min_y != bb.min_y || ba.max_x != bb.max_x ||
+      ba.max_y != bb.max_y) {
+    return false;
+  }
+  *ra = a.exportScale(0, ba, wavog::Aggregation::kMean);
+  *rb = b.exportScale(0, bb, wavog::Aggregation::kMean);
+  return true;
 }
 
 /// Known cells of `r`.

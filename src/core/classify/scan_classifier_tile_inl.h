@@ -162,14 +162,15 @@ inline TileMasks ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0
       past[static_cast<std::size_t>(i)] = low_past ? x.low : x.high;
       unsure |= ~(x.low | x.high);
     }
-    std::array<double, 8> l2 = rows ? dy2 : dx2, c2 = rows ? dx2 : dy2;  // by line, along it
+    const double* l2 = rows ? dy2.data() : dx2.data();  // by line
+    const double* c2 = rows ? dx2.data() : dy2.data();  // along it
     std::uint64_t past_prev = ~unsure;
     for (int i = 0; i < count; ++i) {
       const std::uint64_t p = past[static_cast<std::size_t>(i)];
-      classifySector(box.slo + i, past_prev & ~p, c2.data(), l2.data(), d2r, &m);
+      classifySector(box.slo + i, past_prev & ~p, c2, l2, d2r, &m);
       past_prev = p & ~unsure;
     }
-    classifySector(box.shi, past_prev, c2.data(), l2.data(), d2r, &m);
+    classifySector(box.shi, past_prev, c2, l2, d2r, &m);
     if (!rows) {
       m.e = tile::transpose(m.e);
       m.o = tile::transpose(m.o);
