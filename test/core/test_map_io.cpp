@@ -366,14 +366,22 @@ TEST(MapIo, LogOddsTheUpdateCannotCarryAreRefused) {
 TEST(MapIo, AMapLoadedAtTheBoundSavesFilesThatLoad) {
   const double bound = wavog::kMaxStoredLogOdds;
   const std::string at_bound = tempPath("at_bound.wavog"), saved = tempPath("saved_again.wavog");
-  std::size_t nodes = 0;
+  std::size_t coefficients = 0;
   {
     WaveletMap source(params());
     fill(&source, 42);
     auto& im = wavog::MapAccess::impl(source);
-    // Signs alternating by level and child: some cells add every detail on their path.
+    // Signs alternating by level and child: some cells add every detail on their path, and a
+    // tile's cells (storage/tile.h) sit at the bound with alternating signs.
     std::function<void(wavog::detail::Node&, int)> set = [&](wavog::detail::Node& n, int l) {
-      ++nodes;
+      if (im.hasTile(n)) {
+        wavog::detail::Tile& t = im.tile(n);
+        for (std::size_t i = 0; i < 64; ++i) t.v[i] = i % 3 == 0 ? bound : -bound;
+        t.base = -bound;
+        coefficients += 65;
+        return;
+      }
+      ++coefficients;
       const double sign = l % 2 == 0 ? 1.0 : -1.0;
       n.d[0] = sign * bound;
       n.d[1] = -sign * bound;
@@ -390,7 +398,7 @@ TEST(MapIo, AMapLoadedAtTheBoundSavesFilesThatLoad) {
     }
     source.save(at_bound);
   }
-  ASSERT_GT(nodes, 1000u);
+  ASSERT_GT(coefficients, 1000u);
   for (const wavog::PolicyType type : everyPolicyType()) {
     SCOPED_TRACE(wavog::toString(type));
     MapParams p = MapParams::defaultsFor(type);

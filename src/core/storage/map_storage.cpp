@@ -11,13 +11,14 @@ using detail::Block;
 using detail::Node;
 
 namespace {
-// Spare groups a new block takes from the pool's own free list.
-constexpr std::size_t kLentGroups = 64;
+// Spare groups and tiles a new block takes from the pools' own free lists.
+constexpr std::size_t kLentGroups = 64, kLentTiles = 16;
 }  // namespace
 
 WaveletMap::Impl::Impl(const MapParams& p, bool validate) : params(p) {
   if (validate) throwIfInvalid(p);
   levels = p.grid.block_levels;
+  tile_level = detail::tileLevel(levels);
   configure();
   restartReflection(true);
 }
@@ -91,6 +92,12 @@ std::uint64_t WaveletMap::Impl::scanUnits(double period) const {
 
 void WaveletMap::Impl::freeSubtree(detail::NodeStore& store, Node& n) {
   if (n.children == 0) return;
+  if (hasTile(n)) {
+    store.releaseTile(n.children);
+    n.children = 0;
+    n.child_mask = 0;
+    return;
+  }
   for (int q = 0; q < 4; ++q) {
     if (hasChild(n, q)) {
       freeSubtree(store, child(n, q));
@@ -143,7 +150,8 @@ Block& WaveletMap::Impl::getOrCreateBlock(std::int64_t bx, std::int64_t by) {
   if (res.second) {
     res.first->second.s = init;
     // Groups of erased blocks go to new ones (integrations take only their block's spares).
-    pool.lend(kLentGroups, &res.first->second.spare);
+    pool.lend(kLentGroups, &res.first->second.spare.groups);
+    tiles.lend(kLentTiles, &res.first->second.spare.tiles);
   }
   return res.first->second;
 }
@@ -160,8 +168,12 @@ void WaveletMap::Impl::dropIfEmpty(std::int64_t bx, std::int64_t by) {
 void WaveletMap::Impl::eraseBlock(std::uint64_t key) {
   auto it = blocks.find(key);
   if (it == blocks.end()) return;
-  pool.recycleSpares(&it->second.spare);
-  for (std::uint32_t& part : it->second.part_spare) pool.recycleSpares(&part);
+  const auto recycle = [this](detail::Spares* sp) {
+    pool.recycleSpares(&sp->groups);
+    tiles.recycleSpares(&sp->tiles);
+  };
+  recycle(&it->second.spare);
+  for (detail::Spares& part : it->second.part_spare) recycle(&part);
   blocks.erase(it);
 }
 

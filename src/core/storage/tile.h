@@ -1,0 +1,124 @@
+// Dense leaf tiles: the finest cells below a node of the tile level (3: 8 x 8 cells; the root of a
+// block of 2 levels: 4 x 4) stored as floats, not as a subtree, wherever they are not uniform.
+// A cell's value is the node's Haar average plus f (v - base), f the node's pending forgetting
+// multiplier (its own and its ancestors' tags): the tree above the tile is the Haar tree as
+// elsewhere, and the tile holds what lies below its node's average. An update rewrites only the
+// cells it observes and moves base with the node's average, so a cell the scans do not reach keeps
+// its stored float (no drift from its neighbours' updates, issue 37). Part of WaveletMap's private
+// storage; not installed, included only by src/core/* and the core tests.
+#ifndef WAVOG_MAPPING_SRC_CORE_STORAGE_TILE_H_
+#define WAVOG_MAPPING_SRC_CORE_STORAGE_TILE_H_
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+
+namespace wavog {
+namespace detail {
+
+/// The finest cells of a tile node: cell (x, y) of the tile at index x + 8 y.
+struct Tile {
+  double v[64];         ///< stored values (see the file comment)
+  std::uint64_t known;  ///< bit x + 8 y: the cell was observed
+  double base;          ///< the stored value of a cell at its node's average
+};
+static_assert(std::is_trivial<Tile>::value, "Tile must stay trivial (uncleared pool chunks)");
+static_assert(sizeof(Tile) == 528, "Tile layout grew");
+
+/// Node::child_mask bit of a tile node: Node::children is the index of its Tile.
+constexpr std::uint8_t kTileBit = 0x10;
+
+/// The level of a block's tile nodes: 3, or the root of a block of 2 levels.
+constexpr int tileLevel(int block_levels) { return block_levels < 3 ? block_levels : 3; }
+
+/// The cells of a tile of level t (bit x + 8 y): all 64, or the 4 x 4 of a level-2 tile.
+constexpr std::uint64_t tileCells(int t) { return t >= 3 ? ~std::uint64_t{0} : 0x0F0F0F0Full; }
+
+/// The cells of quadrant q (x offset h (q & 1), y offset h (q >> 1), h half the side) of a tile
+/// of level t.
+constexpr std::uint64_t tileQuadrant(int t, int q) {
+  const int h = 1 << (t - 1);
+  const std::uint64_t row = (std::uint64_t{1} << h) - 1;
+  std::uint64_t m = 0;
+  for (int y = 0; y < h; ++y) m |= row << (8 * y);
+  return m << ((q & 1) * h + (q >> 1) * 8 * h);
+}
+
+/// The cells of the square of side 2^s whose first cell is (x, y) of the tile (bit x + 8 y).
+inline std::uint64_t tileSquare(int s, unsigned x, unsigned y) {
+  const unsigned side = 1u << s;
+  const std::uint64_t row = side >= 8 ? 0xFFull : (std::uint64_t{1} << side) - 1;
+  std::uint64_t m = 0;
+  for (unsigned r = 0; r < side; ++r) m |= row << (8 * r);
+  return m << (x + 8 * y);
+}
+
+/// The mean stored value of the cells of `cells` (not empty).
+inline double tileMean(const Tile& tile, std::uint64_t cells) {
+  double sum = 0.0;
+  for (std::uint64_t m = cells; m != 0; m &= m - 1) sum += tile.v[__builtin_ctzll(m)];
+  return sum / static_cast<double>(__builtin_popcountll(cells));
+}
+
+/// Morton code (x bits even, y bits odd) of tile cell index x + 8 y, and back.
+struct TileMorton {
+  std::array<std::uint8_t, 64> code{}, cell{};
+  constexpr TileMorton() {
+    for (unsigned i = 0; i < 64; ++i) {
+      const unsigned x = i & 7u, y = i >> 3;
+      unsigned c = 0;
+      for (unsigned b = 0; b < 3; ++b)
+        c |= ((x >> b) & 1u) << (2 * b) | ((y >> b) & 1u) << (2 * b + 1);
+      code[i] = static_cast<std::uint8_t>(c);
+      cell[c] = static_cast<std::uint8_t>(i);
+    }
+  }
+};
+inline constexpr TileMorton kTileMorton{};
+
+/// The four knowledge bits of a tile node (bit q: quadrant q) from its cells' mask.
+struct TileKnowledge {
+  unsigned all, any;
+};
+inline TileKnowledge tileKnowledge(int t, std::uint64_t known) {
+  TileKnowledge k{0, 0};
+  for (int q = 0; q < 4; ++q) {
+    const std::uint64_t m = tileQuadrant(t, q);
+    k.all |= static_cast<unsigned>((known & m) == m) << q;
+    k.any |= static_cast<unsigned>((known & m) != 0) << q;
+  }
+  return k;
+}
+
+/// True when every cell of a tile of level t lies within tol of the node's average (f = 1) and
+/// the cells are all observed or none: the tile carries nothing beyond its node's summary.
+inline bool tileUniform(const Tile& tile, int t, double tol) {
+  const std::uint64_t cells = tileCells(t);
+  const std::uint64_t k = tile.known & cells;
+  if (k != 0 && k != cells) return false;
+  const double lo = tile.base - tol, hi = tile.base + tol;
+  for (std::uint64_t m = cells; m != 0; m &= m - 1) {
+    const double v = tile.v[__builtin_ctzll(m)];
+    if (!(v >= lo && v <= hi)) return false;
+  }
+  return true;
+}
+
+/// A tile of level t uniform at its node's average, observed entirely or not at all.
+inline void fillTile(Tile* tile, int t, bool known) {
+  for (double& v : tile->v) v = 0.0;
+  tile->base = 0.0;
+  tile->known = known ? tileCells(t) : 0;
+}
+
+/// Applies a pending multiplier m to the stored values (the node's tag, flushed).
+inline void scaleTile(Tile* tile, double m) {
+  const double b = tile->base;
+  for (double& v : tile->v) v = b + m * (v - b);
+}
+
+}  // namespace detail
+}  // namespace wavog
+
+#endif  // WAVOG_MAPPING_SRC_CORE_STORAGE_TILE_H_
