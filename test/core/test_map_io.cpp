@@ -17,6 +17,7 @@
 #include <functional>
 #include <future>
 #include <iterator>
+#include <type_traits>
 
 #include "map_access.h"
 #include "test_support.h"
@@ -375,9 +376,12 @@ TEST(MapIo, AMapLoadedAtTheBoundSavesFilesThatLoad) {
     // tile's cells (storage/tile.h) sit at the bound with alternating signs.
     std::function<void(wavog::detail::Node&, int)> set = [&](wavog::detail::Node& n, int l) {
       if (im.hasTile(n)) {
-        wavog::detail::Tile& t = im.tile(n);
-        for (std::size_t i = 0; i < 64; ++i) t.v[i] = i % 3 == 0 ? bound : -bound;
-        t.base = -bound;
+        im.withTile(n, [&](auto& t) {
+          using T = std::remove_reference_t<decltype(t.v[0])>;
+          const T at = wavog::detail::storedValue<T>(bound);  // a float rounds the bound up
+          for (std::size_t i = 0; i < 64; ++i) t.v[i] = i % 3 == 0 ? at : -at;
+          t.base = -bound;
+        });
         coefficients += 65;
         return;
       }

@@ -37,6 +37,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "file/map_codec.h"
@@ -88,12 +89,13 @@ void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
   w->put(static_cast<std::uint8_t>(n.known_all));
   w->put(static_cast<std::uint8_t>(n.known_any));
   if (WaveletMap::Impl::hasTile(n)) {
-    const detail::Tile& t = impl.tile(n);
-    w->put(t.known);
-    w->put(t.base);
-    for (std::uint64_t m = detail::tileCells(impl.tile_level); m != 0; m &= m - 1) {
-      w->put(t.v[__builtin_ctzll(m)]);
-    }
+    impl.withTile(n, [&](const auto& t) {
+      w->put(t.known);
+      w->put(t.base);
+      for (std::uint64_t m = detail::tileCells(impl.tile_level); m != 0; m &= m - 1) {
+        w->put(static_cast<double>(t.v[__builtin_ctzll(m)]));
+      }
+    });
     return;
   }
   if (l <= 1) return;
@@ -131,10 +133,22 @@ void checkUniformKnowledge(bool all, bool any) {
   if (all != any) throw std::runtime_error("a uniform slot partly observed");
 }
 
+// Stores `cells` as the tile of node n (a fresh map's), float or wide as the map keeps them.
+void storeTile(WaveletMap::Impl& impl, Node& n, const detail::WideTile& cells) {
+  detail::NodeStore store = impl.serialStore();
+  impl.addTile(store, n);
+  impl.withTile(n, [&](auto& t) {
+    using T = std::remove_reference_t<decltype(t.v[0])>;
+    for (std::size_t i = 0; i < 64; ++i) t.v[i] = detail::storedValue<T>(cells.v[i]);
+    t.known = cells.known;
+    t.base = cells.base;
+  });
+}
+
 // Reads the tile of node n (a fresh map's; its flags read and checked).
 void readTile(WaveletMap::Impl& impl, Node& n, Reader* r) {
-  detail::NodeStore store = impl.serialStore();
-  detail::Tile& t = impl.addTile(store, n);
+  detail::WideTile t;
+  detail::fillTile(&t, impl.tile_level, false);
   const std::uint64_t cells = detail::tileCells(impl.tile_level);
   t.known = r->get<std::uint64_t>();
   t.base = r->get<double>();
@@ -157,12 +171,13 @@ void readTile(WaveletMap::Impl& impl, Node& n, Reader* r) {
   for (double d : n.d) {
     if (d != 0.0) throw std::runtime_error("a tile node with details");
   }
+  storeTile(impl, n, t);
 }
 
 // The cells below node n (level l, first cell (x0, y0) of its tile, average avg, pending
 // multiplier of its details mult) into tile t, with their knowledge.
 void tileCellsOf(const WaveletMap::Impl& impl, const Node& n, int l, unsigned x0, unsigned y0,
-                 double avg, double mult, detail::Tile* t) {
+                 double avg, double mult, detail::WideTile* t) {
   const double d[3] = {n.d[0] * mult, n.d[1] * mult, n.d[2] * mult};
   const auto c = haar::backward(avg, d);
   const unsigned half = 1u << (l - 1);
@@ -186,13 +201,13 @@ void tileCellsOf(const WaveletMap::Impl& impl, const Node& n, int l, unsigned x0
 // may hold one too): n and its subtree become a tile node,
 // its cells at base 0 (their value minus the node's average); n keeps its pending count.
 void makeTile(WaveletMap::Impl& impl, Node& n) {
-  detail::Tile cells;
+  detail::WideTile cells;
   detail::fillTile(&cells, impl.tile_level, false);
   tileCellsOf(impl, n, impl.tile_level, 0, 0, 0.0, 1.0, &cells);
   detail::NodeStore store = impl.serialStore();
   impl.freeSubtree(store, n);
   n.d[0] = n.d[1] = n.d[2] = 0.0;
-  impl.addTile(store, n) = cells;
+  storeTile(impl, n, cells);
 }
 
 // Reads a subtree into `impl` (a fresh map); `slot_all` / `slot_any`: the knowledge its slot
@@ -232,7 +247,7 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
   if (tile) {
     if (l != impl.tile_level) throw std::runtime_error("a tile off the tile level");
     readTile(impl, n, r);
-    if (applied != 1.0) detail::scaleTile(&impl.tile(n), applied);
+    if (applied != 1.0) impl.withTile(n, [&](auto& t) { detail::scaleTile(&t, applied); });
     return;
   }
   for (int q = 0; q < 4; ++q) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "update/map_slot.h"
@@ -25,22 +26,27 @@ struct ClearBox {
 // clearNode() of a tile node (tag flushed; a uniform one is given a tile first).
 double clearTile(WaveletMap::Impl& impl, detail::NodeStore& store, Node& n, std::int64_t ix0,
                  std::int64_t iy0, double s, const ClearBox& box) {
-  detail::Tile& t = impl.hasTile(n) ? impl.tile(n) : impl.addTile(store, n);
+  if (!impl.hasTile(n)) impl.addTile(store, n);
   const std::int64_t side = std::int64_t{1} << impl.tile_level;
   const std::int64_t x0 = std::max(box.x0, ix0) - ix0, x1 = std::min(box.x1, ix0 + side - 1) - ix0;
   const std::int64_t y0 = std::max(box.y0, iy0) - iy0, y1 = std::min(box.y1, iy0 + side - 1) - iy0;
-  const double offset = t.base - s;  // stored value of a cell minus its value
-  double sum = 0.0;
-  for (std::int64_t y = y0; y <= y1; ++y) {
-    for (std::int64_t x = x0; x <= x1; ++x) {
-      double& v = t.v[x + 8 * y];
-      sum += impl.init - (v - offset);
-      v = detail::keepStored(impl.init + offset);
-      t.known &= ~(std::uint64_t{1} << (x + 8 * y));
+  const double ds = impl.withTile(n, [&](auto& t) {
+    using T = std::remove_reference_t<decltype(t.v[0])>;
+    const double offset = t.base - s;  // stored value of a cell minus its value
+    double sum = 0.0;
+    for (std::int64_t y = y0; y <= y1; ++y) {
+      for (std::int64_t x = x0; x <= x1; ++x) {
+        T& v = t.v[x + 8 * y];
+        const T now = detail::storedValue<T>(detail::keepStored(impl.init + offset));
+        sum += static_cast<double>(now) - static_cast<double>(v);
+        v = now;
+        t.known &= ~(std::uint64_t{1} << (x + 8 * y));
+      }
     }
-  }
-  const double ds = sum / static_cast<double>(side * side);
-  t.base = detail::keepStored(t.base + ds);
+    const double change = sum / static_cast<double>(side * side);
+    t.base = detail::keepStored(t.base + change);
+    return change;
+  });
   impl.dropTileIfUniform(store, n);
   return ds;
 }

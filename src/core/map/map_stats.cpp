@@ -11,8 +11,9 @@ using detail::Node;
 namespace {
 std::uint64_t countObserved(const WaveletMap::Impl& impl, const Node& n, int l) {
   if (impl.hasTile(n)) {
+    const std::uint64_t known = impl.withTile(n, [](const auto& t) { return t.known; });
     return static_cast<std::uint64_t>(
-        __builtin_popcountll(impl.tile(n).known & detail::tileCells(impl.tile_level)));
+        __builtin_popcountll(known & detail::tileCells(impl.tile_level)));
   }
   std::uint64_t count = 0;
   for (int q = 0; q < 4; ++q) {

@@ -44,7 +44,7 @@ class RasterWriter {
     }
     const double m = mult * impl_.multiplier(n->k);
     if (impl_.hasTile(*n)) {
-      tile(impl_.tile(*n), l, ix0, iy0, avg, m);
+      impl_.withTile(*n, [&](const auto& t) { tile(t, l, ix0, iy0, avg, m); });
       return;
     }
     const double d[3] = {n->d[0] * m, n->d[1] * m, n->d[2] * m};
@@ -61,8 +61,8 @@ class RasterWriter {
  private:
   // The raster cells of a tile of level l > s_ (origin ix0, iy0; its node's average avg, the
   // factor of its values m): each the mean, or the max over the observed, of its cells.
-  void tile(const detail::Tile& t, int l, std::int64_t ix0, std::int64_t iy0, double avg,
-            double m) {
+  template <typename Tile>
+  void tile(const Tile& t, int l, std::int64_t ix0, std::int64_t iy0, double avg, double m) {
     const unsigned side = 1u << s_, n = 1u << l;
     for (unsigned y = 0; y < n; y += side) {
       for (unsigned x = 0; x < n; x += side) {
@@ -75,7 +75,8 @@ class RasterWriter {
   }
 
   // Max over the cells `known` of a tile (its node's average avg, the factor of its values m).
-  static float maxOf(const detail::Tile& t, std::uint64_t known, double avg, double m) {
+  template <typename Tile>
+  static float maxOf(const Tile& t, std::uint64_t known, double avg, double m) {
     float best = kNoObservedCell;
     for (; known != 0; known &= known - 1) {
       const double v = avg + m * (t.v[__builtin_ctzll(known)] - t.base);
@@ -87,7 +88,9 @@ class RasterWriter {
   // Max over the observed finest cells below node n (level l, average avg).
   float maxObserved(const Node& n, int l, double avg, double mult) const {
     const double m = mult * impl_.multiplier(n.k);
-    if (impl_.hasTile(n)) return maxOf(impl_.tile(n), impl_.tile(n).known, avg, m);
+    if (impl_.hasTile(n)) {
+      return impl_.withTile(n, [&](const auto& t) { return maxOf(t, t.known, avg, m); });
+    }
     const double d[3] = {n.d[0] * m, n.d[1] * m, n.d[2] * m};
     const auto c = haar::backward(avg, d);
     float best = kNoObservedCell;

@@ -50,12 +50,14 @@ WaveletMap::Impl::SlotRead WaveletMap::Impl::read(int s, std::int64_t x, std::in
     mult *= multiplier(n->k);
     if (hasTile(*n)) {
       // The square of side 2^s holding the cell, within the tile (l = tile_level).
-      const detail::Tile& t = tile(*n);
       const std::int64_t mask = (std::int64_t{1} << l) - 1;
       const std::uint64_t cells =
           detail::tileSquare(s, static_cast<unsigned>(fx & mask), static_cast<unsigned>(fy & mask));
-      const std::uint64_t known = t.known & cells;
-      return {avg + mult * (detail::tileMean(t, cells) - t.base), known == cells, known != 0};
+      return withTile(*n, [&](const auto& t) {
+        const std::uint64_t known = t.known & cells;
+        return SlotRead{avg + mult * (detail::tileMean(t, cells) - t.base), known == cells,
+                        known != 0};
+      });
     }
     const int q = static_cast<int>(((fx >> (l - 1)) & 1) | (((fy >> (l - 1)) & 1) << 1));
     const double d[3] = {n->d[0] * mult, n->d[1] * mult, n->d[2] * mult};

@@ -122,29 +122,40 @@ struct WaveletMap::Impl {
   bool hasChild(const detail::Node& n, int q) const { return (n.child_mask >> q) & 1u; }
   /// A tile node's cells (storage/tile.h).
   static bool hasTile(const detail::Node& n) { return (n.child_mask & detail::kTileBit) != 0; }
-  detail::Tile& tile(const detail::Node& n) { return tiles.group(n.children); }
-  const detail::Tile& tile(const detail::Node& n) const { return tiles.group(n.children); }
+  /// Returns f(tile) for the tile of node n, a FloatTile or a WideTile (tiles.wide()).
+  template <typename F>
+  decltype(auto) withTile(const detail::Node& n, F&& f) {
+    if (tiles.wide()) return f(tiles.wideTiles().group(n.children));
+    return f(tiles.narrow().group(n.children));
+  }
+  template <typename F>
+  decltype(auto) withTile(const detail::Node& n, F&& f) const {
+    if (tiles.wide()) return f(tiles.wideTiles().group(n.children));
+    return f(tiles.narrow().group(n.children));
+  }
   /// Gives node n (tag flushed, no children) a tile, uniform at its average, observed as its
   /// knowledge bits say.
-  detail::Tile& addTile(detail::NodeStore& store, detail::Node& n) {
+  void addTile(detail::NodeStore& store, detail::Node& n) {
     n.children = store.allocateTile();
     n.child_mask = detail::kTileBit;
-    detail::Tile& t = tile(n);
-    detail::fillTile(&t, tile_level, n.known_any != 0);
-    return t;
+    withTile(n, [&](auto& t) { detail::fillTile(&t, tile_level, n.known_any != 0); });
   }
   /// Frees the tile of node n when it carries nothing beyond n's average (tileUniform): n then
   /// has no children, and its knowledge bits are those of the tile.
   void dropTileIfUniform(detail::NodeStore& store, detail::Node& n) {
-    detail::Tile& t = tile(n);
-    const detail::TileKnowledge k = detail::tileKnowledge(tile_level, t.known);
-    n.known_all = k.all & 0xFu;  // 4-bit masks
-    n.known_any = k.any & 0xFu;
-    if (!detail::tileUniform(t, tile_level, prune_threshold)) return;
+    const bool uniform = withTile(n, [&](const auto& t) {
+      const detail::TileKnowledge k = detail::tileKnowledge(tile_level, t.known);
+      n.known_all = k.all & 0xFu;  // 4-bit masks
+      n.known_any = k.any & 0xFu;
+      return detail::tileUniform(t, tile_level, prune_threshold);
+    });
+    if (!uniform) return;
     store.releaseTile(n.children);
     n.children = 0;
     n.child_mask = 0;
   }
+  /// Makes every tile float, or wide (storage/tile.h), as the policy needs (configure()).
+  void setTileKind(bool wide);
 
   /// Node groups and counts for one thread at a time: the pools' own free lists, the map's
   /// counts.
@@ -250,7 +261,7 @@ inline void WaveletMap::Impl::flush(detail::Node& n) {
   const double m = multiplier(n.k);
   for (double& d : n.d) d *= m;
   if (hasTile(n)) {
-    detail::scaleTile(&tile(n), m);
+    withTile(n, [m](auto& t) { detail::scaleTile(&t, m); });
   } else if (n.children != 0) {
     for (int q = 0; q < 4; ++q) {
       if (hasChild(n, q)) addPending(child(n, q), n.k);

@@ -2,6 +2,8 @@
 // creation and deletion, flushing every lazy tag, block lookup and creation.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <type_traits>
 
 #include "storage/map_impl.h"
 
@@ -24,6 +26,9 @@ WaveletMap::Impl::Impl(const MapParams& p, bool validate) : params(p) {
 }
 
 void WaveletMap::Impl::configure() {
+  const PolicyType type = params.policy.type;
+  setTileKind(type == PolicyType::kNone || type == PolicyType::kClampLower ||
+              type == PolicyType::kClampUpper);
   init = params.initValue();
   const bool forget = params.policy.type == PolicyType::kForget;
   a = forget ? 1.0 - params.policy.gamma : 1.0;
@@ -117,6 +122,54 @@ void WaveletMap::Impl::removeChild(detail::NodeStore& store, Node& n, int q) {
     store.release(n.children);
     n.children = 0;
   }
+}
+
+namespace {
+// Calls f(n) for every tile node of the subtree of n.
+template <typename F>
+void forEachTileNode(WaveletMap::Impl& impl, Node& n, F& f) {
+  if (WaveletMap::Impl::hasTile(n)) {
+    f(n);
+    return;
+  }
+  if (n.children == 0) return;
+  for (int q = 0; q < 4; ++q) {
+    if (impl.hasChild(n, q)) forEachTileNode(impl, impl.child(n, q), f);
+  }
+}
+
+// Copies the tile of node n from pool `from` into a new one of pool `to`.
+template <typename From, typename To>
+void moveTile(Node& n, detail::ChunkPool<From>& from, detail::ChunkPool<To>& to) {
+  using T = std::remove_reference_t<decltype(To{}.v[0])>;
+  const std::uint32_t i = to.allocate(false);
+  const From& a = from.group(n.children);
+  To& b = to.group(i);
+  for (std::size_t c = 0; c < 64; ++c) b.v[c] = detail::storedValue<T>(a.v[c]);
+  b.known = a.known;
+  b.base = a.base;
+  from.release(n.children);
+  n.children = i;
+}
+}  // namespace
+
+void WaveletMap::Impl::setTileKind(bool wide) {
+  if (wide == tiles.wide()) return;
+  for (auto& kv : blocks) {
+    tiles.recycleSpares(&kv.second.spare.tiles);
+    for (detail::Spares& part : kv.second.part_spare) tiles.recycleSpares(&part.tiles);
+  }
+  auto convert = [&](Node& n) {
+    if (wide) {
+      moveTile(n, tiles.narrow(), tiles.wideTiles());
+    } else {
+      moveTile(n, tiles.wideTiles(), tiles.narrow());
+    }
+  };
+  for (auto& kv : blocks) {
+    if (kv.second.has_root) forEachTileNode(*this, kv.second.root, convert);
+  }
+  tiles.setWide(wide);
 }
 
 namespace {

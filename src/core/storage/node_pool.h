@@ -83,11 +83,11 @@ class ChunkPool {
   }
   /// A cleared element from the pool's own free list or a new one (one thread at a time). The
   /// pool counts none of them: the map does (StoreCounts).
-  std::uint32_t allocate() {
-    if (free_.empty()) return fresh();
+  std::uint32_t allocate(bool cleared = true) {
+    if (free_.empty()) return fresh(cleared);
     const std::uint32_t g = free_.back();
     free_.pop_back();
-    group(g) = T{};
+    if (cleared) group(g) = T{};
     return g;
   }
   /// Gives element g back to the pool's own free list (one thread at a time).
@@ -118,14 +118,14 @@ class ChunkPool {
   void recycleSpares(std::uint32_t* list) {
     while (*list != 0) recycle(popSpare(list));
   }
-  /// A cleared, never used group. Safe from several threads within the reserved room; it does
-  /// not count the group as live (the caller does, see NodeStore).
-  std::uint32_t fresh() {
+  /// A never used element, cleared unless `cleared` is false. Safe from several threads within the
+  /// reserved room; it does not count the element as live (the caller does, see NodeStore).
+  std::uint32_t fresh(bool cleared = true) {
     const std::uint32_t g = next_.fetch_add(1, std::memory_order_relaxed);
     const std::size_t c = g >> kChunkBits;
     if (c >= capacity_) growTable(c + 1);  // only without reserveFresh(): single-threaded use
     T* p = chunk(c);
-    p[g & kChunkMask] = T{};
+    if (cleared) p[g & kChunkMask] = T{};
     return g;
   }
   /// Makes room in the chunk table for `groups` more fresh() calls (one thread, before a
@@ -200,7 +200,53 @@ class ChunkPool {
 };
 
 using NodePool = ChunkPool<NodeGroup>;
-using TilePool = ChunkPool<Tile>;
+
+/// The tiles of a map: float ones, or wide (double) ones under the unbounded policies
+/// (storage/tile.h); a map holds one kind at a time, in its pool (the same indices either way).
+class TilePool {
+ public:
+  bool wide() const { return wide_; }
+  /// Switches the kind of new tiles (the map converts its tiles and spares first).
+  void setWide(bool wide) { wide_ = wide; }
+  ChunkPool<FloatTile>& narrow() { return narrow_; }
+  ChunkPool<WideTile>& wideTiles() { return wide_tiles_; }
+  const ChunkPool<FloatTile>& narrow() const { return narrow_; }
+  const ChunkPool<WideTile>& wideTiles() const { return wide_tiles_; }
+
+  void clear() {
+    narrow_.clear();
+    wide_tiles_.clear();
+  }
+  std::uint32_t allocate() { return wide_ ? wide_tiles_.allocate(false) : narrow_.allocate(false); }
+  std::uint32_t fresh() { return wide_ ? wide_tiles_.fresh(false) : narrow_.fresh(false); }
+  void release(std::uint32_t t) { wide_ ? wide_tiles_.release(t) : narrow_.release(t); }
+  void lend(std::size_t count, std::uint32_t* spare) {
+    wide_ ? wide_tiles_.lend(count, spare) : narrow_.lend(count, spare);
+  }
+  void pushSpare(std::uint32_t* list, std::uint32_t t) {
+    wide_ ? wide_tiles_.pushSpare(list, t) : narrow_.pushSpare(list, t);
+  }
+  std::uint32_t popSpare(std::uint32_t* list) {
+    return wide_ ? wide_tiles_.popSpare(list) : narrow_.popSpare(list);
+  }
+  void recycleSpares(std::uint32_t* list) {
+    wide_ ? wide_tiles_.recycleSpares(list) : narrow_.recycleSpares(list);
+  }
+  void reserveFresh(std::size_t tiles) {
+    wide_ ? wide_tiles_.reserveFresh(tiles) : narrow_.reserveFresh(tiles);
+  }
+  std::size_t bytes(std::size_t live) const {
+    return wide_ ? wide_tiles_.bytes(live) : narrow_.bytes(live);
+  }
+  std::size_t bytesReserved() const {
+    return narrow_.bytesReserved() + wide_tiles_.bytesReserved();
+  }
+
+ private:
+  ChunkPool<FloatTile> narrow_;
+  ChunkPool<WideTile> wide_tiles_;
+  bool wide_ = false;
+};
 
 /// The spare lists of a block or of a part of one (ChunkPool::pushSpare): node groups and tiles.
 struct Spares {
@@ -239,10 +285,11 @@ class NodeStore {
       pool_.pushSpare(&spare_->groups, g);
     }
   }
-  /// A tile (uncleared).
+  /// A tile, not cleared (the caller fills it).
   std::uint32_t allocateTile() {
     ++counts_->tiles;
-    return spare_ == nullptr ? tiles_.allocate() : take(tiles_, &spare_->tiles);
+    if (spare_ == nullptr) return tiles_.allocate();
+    return spare_->tiles != 0 ? tiles_.popSpare(&spare_->tiles) : tiles_.fresh();
   }
   void releaseTile(std::uint32_t t) {
     --counts_->tiles;

@@ -315,34 +315,39 @@ class Integrator {
       });
     }
     if (observed == 0) return 0.0;
-    Tile& tile = WaveletMap::Impl::hasTile(n) ? impl_.tile(n) : impl_.addTile(store_, n);
-    // A cell's value is s + (v - base): stored value minus `offset`.
-    const double offset = tile.base - s;
-    double sum = 0.0;
-    for (std::uint64_t m = cells.e; m != 0; m &= m - 1) {
-      sum += updateCell(&tile.v[__builtin_ctzll(m)], offset, CellClass::kEmpty);
-    }
-    for (std::uint64_t m = cells.o; m != 0; m &= m - 1) {
-      const auto i = static_cast<unsigned>(__builtin_ctzll(m));
-      if constexpr (kHits) {
-        observed_->push_back({slot_code_ + kTileMorton.code[i], tile.v[i] - offset});
+    if (!WaveletMap::Impl::hasTile(n)) impl_.addTile(store_, n);
+    const double ds = impl_.withTile(n, [&](auto& tile) {
+      // A cell's value is s + (v - base): stored value minus `offset`.
+      const double offset = tile.base - s;
+      double sum = 0.0;
+      for (std::uint64_t m = cells.e; m != 0; m &= m - 1) {
+        sum += updateCell(&tile.v[__builtin_ctzll(m)], offset, CellClass::kEmpty);
       }
-      sum += updateCell(&tile.v[i], offset, CellClass::kOccupied);
-    }
-    tile.known |= observed;
-    // The cells' mean moved by ds: so does base, and the unobserved cells keep their values.
-    const double ds = sum / static_cast<double>(std::uint64_t{1} << (2 * t));
-    tile.base = keepStored(tile.base + ds);
+      for (std::uint64_t m = cells.o; m != 0; m &= m - 1) {
+        const auto i = static_cast<unsigned>(__builtin_ctzll(m));
+        if constexpr (kHits) {
+          observed_->push_back({slot_code_ + kTileMorton.code[i], tile.v[i] - offset});
+        }
+        sum += updateCell(&tile.v[i], offset, CellClass::kOccupied);
+      }
+      tile.known |= observed;
+      // The cells' mean moved by the change: so does base, and the unobserved cells keep their
+      // stored values.
+      const double change = sum / static_cast<double>(std::uint64_t{1} << (2 * t));
+      tile.base = keepStored(tile.base + change);
+      return change;
+    });
     impl_.dropTileIfUniform(store_, n);
     return ds;
   }
 
   // Applies the policy for `cls` to the cell stored at *v (value *v - offset); returns the change
-  // of its value as stored.
-  [[gnu::always_inline]] double updateCell(double* v, double offset, CellClass cls) const {
-    const double c = *v - offset;
-    *v = keepStored(applyPolicy<P>(pc_, cls, c) + offset);
-    return (*v - offset) - c;
+  // of its stored value.
+  template <typename T>
+  [[gnu::always_inline]] double updateCell(T* v, double offset, CellClass cls) const {
+    const double was = static_cast<double>(*v);
+    *v = storedValue<T>(keepStored(applyPolicy<P>(pc_, cls, was - offset) + offset));
+    return static_cast<double>(*v) - was;
   }
 
   // Eager forgetting (lazy tags off): every detail of the subtree times a, now.
@@ -351,7 +356,7 @@ class Integrator {
     for (double& d : n.d) d *= pc_.a;
     if (WaveletMap::Impl::hasTile(n)) {
       visited_ += std::uint64_t{1} << (2 * impl_.tile_level);  // its cells
-      scaleTile(&impl_.tile(n), pc_.a);
+      impl_.withTile(n, [this](auto& t) { scaleTile(&t, pc_.a); });
       return;
     }
     if (n.children == 0) return;
