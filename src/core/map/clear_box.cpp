@@ -37,7 +37,7 @@ double clearTile(WaveletMap::Impl& impl, detail::NodeStore& store, Node& n, std:
     for (std::int64_t y = y0; y <= y1; ++y) {
       for (std::int64_t x = x0; x <= x1; ++x) {
         T& v = t.v[x + 8 * y];
-        const T now = detail::storedValue<T>(detail::keepStored(impl.init + offset));
+        const T now = detail::storedValue<T>(impl.init + offset);
         sum += static_cast<double>(now) - static_cast<double>(v);
         v = now;
         t.known &= ~(std::uint64_t{1} << (x + 8 * y));

@@ -37,16 +37,21 @@ static_assert(std::is_trivial<FloatTile>::value && std::is_trivial<WideTile>::va
               "tiles must stay trivial (uncleared pool chunks)");
 static_assert(sizeof(FloatTile) == 272 && sizeof(WideTile) == 528, "Tile layout grew");
 
-/// v (within +-kMaxStoredLogOdds, limits.h) as a tile stores it: rounded to T, and kept within the
-/// bound (a float rounds 1e30 up), so that every file a map saves loads.
+/// The largest float within kMaxStoredLogOdds (limits.h): a float rounds 1e30 up.
+constexpr float kMaxStoredFloat = 9.99999939e29f;
+static_assert(kMaxStoredFloat <= kMaxStoredLogOdds &&
+                  kMaxStoredFloat * (1.0 + 1.0 / (1 << 23)) > kMaxStoredLogOdds,
+              "kMaxStoredFloat is the float below the bound");
+
+/// v as a tile stores it: within the bound of a map file (keepStored(), map_slot.h; for a float,
+/// kMaxStoredFloat), rounded to T, so that every file a map saves loads. x > lo ? x : lo and
+/// x < hi ? x : hi are one maxsd and one minsd (NaN goes to the lower bound).
 template <typename T>
 inline T storedValue(double v) {
-  static const T kMax = [] {
-    const auto m = static_cast<T>(kMaxStoredLogOdds);
-    return static_cast<double>(m) > kMaxStoredLogOdds ? std::nextafter(m, T{0}) : m;
-  }();
-  const auto r = static_cast<T>(v);
-  return r > kMax ? kMax : (r < -kMax ? -kMax : r);
+  constexpr double kMax =
+      std::is_same<T, float>::value ? static_cast<double>(kMaxStoredFloat) : kMaxStoredLogOdds;
+  const double up = v > -kMax ? v : -kMax;
+  return static_cast<T>(up < kMax ? up : kMax);
 }
 
 /// Node::child_mask bit of a tile node: Node::children is the index of its Tile.
@@ -68,13 +73,30 @@ constexpr std::uint64_t tileQuadrant(int t, int q) {
   return m << ((q & 1) * h + (q >> 1) * 8 * h);
 }
 
+/// The masks above as a table (they are asked for on every tile update and read).
+struct TileShapes {
+  std::uint64_t quadrant[2][4]{};  ///< [t - 2][q]: tileQuadrant(t, q)
+  std::uint64_t square[4]{};       ///< [s]: the square of side 2^s at (0, 0)
+  constexpr TileShapes() {
+    for (int t = 2; t <= 3; ++t) {
+      for (int q = 0; q < 4; ++q) quadrant[t - 2][q] = tileQuadrant(t, q);
+    }
+    for (int s = 0; s <= 3; ++s) square[s] = tileQuadrant(s + 1, 0);
+  }
+};
+inline constexpr TileShapes kTileShapes{};
+
 /// The cells of the square of side 2^s whose first cell is (x, y) of the tile (bit x + 8 y).
 inline std::uint64_t tileSquare(int s, unsigned x, unsigned y) {
-  const unsigned side = 1u << s;
-  const std::uint64_t row = side >= 8 ? 0xFFull : (std::uint64_t{1} << side) - 1;
-  std::uint64_t m = 0;
-  for (unsigned r = 0; r < side; ++r) m |= row << (8 * r);
-  return m << (x + 8 * y);
+  return kTileShapes.square[s] << (x + 8 * y);
+}
+
+/// The cells of mask m, without a library call (the baseline build has no popcnt instruction).
+inline unsigned cellCount(std::uint64_t m) {
+  m -= (m >> 1) & 0x5555555555555555ull;
+  m = (m & 0x3333333333333333ull) + ((m >> 2) & 0x3333333333333333ull);
+  m = (m + (m >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return static_cast<unsigned>((m * 0x0101010101010101ull) >> 56);
 }
 
 /// The mean stored value of the cells of `cells` (not empty).
@@ -82,7 +104,7 @@ template <typename Tile>
 inline double tileMean(const Tile& tile, std::uint64_t cells) {
   double sum = 0.0;
   for (std::uint64_t m = cells; m != 0; m &= m - 1) sum += tile.v[__builtin_ctzll(m)];
-  return sum / static_cast<double>(__builtin_popcountll(cells));
+  return sum / static_cast<double>(cellCount(cells));
 }
 
 /// Morton code (x bits even, y bits odd) of tile cell index x + 8 y, and back.
@@ -108,7 +130,7 @@ struct TileKnowledge {
 inline TileKnowledge tileKnowledge(int t, std::uint64_t known) {
   TileKnowledge k{0, 0};
   for (int q = 0; q < 4; ++q) {
-    const std::uint64_t m = tileQuadrant(t, q);
+    const std::uint64_t m = kTileShapes.quadrant[t - 2][q];
     k.all |= static_cast<unsigned>((known & m) == m) << q;
     k.any |= static_cast<unsigned>((known & m) != 0) << q;
   }

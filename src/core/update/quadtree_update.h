@@ -308,7 +308,7 @@ class Integrator {
     const int t = impl_.tile_level;
     const TileMasks cells = cls_.classifyTileCells(t, ix0, iy0, box);
     const std::uint64_t observed = cells.e | cells.o;
-    visited_ += static_cast<std::uint64_t>(__builtin_popcountll(observed));
+    visited_ += cellCount(observed);
     if constexpr (kNdt) {
       slot_span_.forEach([&](NdtEntry* x) {
         if ((observed >> kTileMorton.cell[x->code & 63u]) & 1u) ndt_->forget(x);
@@ -320,7 +320,16 @@ class Integrator {
       // A cell's value is s + (v - base): stored value minus `offset`.
       const double offset = tile.base - s;
       double sum = 0.0;
-      for (std::uint64_t m = cells.e; m != 0; m &= m - 1) {
+      std::uint64_t e = cells.e;
+      for (unsigned row = 0; row < 64; row += 8) {
+        // A row all E (most rows of the cleared space) without a bit scan.
+        if (((e >> row) & 0xFFu) != 0xFFu) continue;
+        for (unsigned x = 0; x < 8; ++x) {
+          sum += updateCell(&tile.v[row + x], offset, CellClass::kEmpty);
+        }
+        e &= ~(std::uint64_t{0xFF} << row);
+      }
+      for (std::uint64_t m = e; m != 0; m &= m - 1) {
         sum += updateCell(&tile.v[__builtin_ctzll(m)], offset, CellClass::kEmpty);
       }
       for (std::uint64_t m = cells.o; m != 0; m &= m - 1) {
@@ -346,7 +355,7 @@ class Integrator {
   template <typename T>
   [[gnu::always_inline]] double updateCell(T* v, double offset, CellClass cls) const {
     const double was = static_cast<double>(*v);
-    *v = storedValue<T>(keepStored(applyPolicy<P>(pc_, cls, was - offset) + offset));
+    *v = storedValue<T>(applyPolicy<P>(pc_, cls, was - offset) + offset);
     return static_cast<double>(*v) - was;
   }
 
