@@ -319,25 +319,26 @@ class Integrator {
     const double ds = impl_.withTile(n, [&](auto& tile) {
       // A cell's value is s + (v - base): stored value minus `offset`.
       const double offset = tile.base - s;
+      const ShiftedPolicy sp = shiftPolicy<P>(pc_, offset);
       double sum = 0.0;
       std::uint64_t e = cells.e;
       for (unsigned row = 0; row < 64; row += 8) {
         // A row all E (most rows of the cleared space) without a bit scan.
         if (((e >> row) & 0xFFu) != 0xFFu) continue;
         for (unsigned x = 0; x < 8; ++x) {
-          sum += updateCell(&tile.v[row + x], offset, CellClass::kEmpty);
+          sum += updateCell(&tile.v[row + x], sp, CellClass::kEmpty);
         }
         e &= ~(std::uint64_t{0xFF} << row);
       }
       for (std::uint64_t m = e; m != 0; m &= m - 1) {
-        sum += updateCell(&tile.v[__builtin_ctzll(m)], offset, CellClass::kEmpty);
+        sum += updateCell(&tile.v[__builtin_ctzll(m)], sp, CellClass::kEmpty);
       }
       for (std::uint64_t m = cells.o; m != 0; m &= m - 1) {
         const auto i = static_cast<unsigned>(__builtin_ctzll(m));
         if constexpr (kHits) {
           observed_->push_back({slot_code_ + kTileMorton.code[i], tile.v[i] - offset});
         }
-        sum += updateCell(&tile.v[i], offset, CellClass::kOccupied);
+        sum += updateCell(&tile.v[i], sp, CellClass::kOccupied);
       }
       tile.known |= observed;
       // The cells' mean moved by the change: so does base, and the unobserved cells keep their
@@ -350,12 +351,12 @@ class Integrator {
     return ds;
   }
 
-  // Applies the policy for `cls` to the cell stored at *v (value *v - offset); returns the change
-  // of its stored value.
+  // Applies the policy for `cls` (shifted to the stored values) to the cell stored at *v; returns
+  // the change of its stored value.
   template <typename T>
-  [[gnu::always_inline]] double updateCell(T* v, double offset, CellClass cls) const {
+  [[gnu::always_inline]] static double updateCell(T* v, const ShiftedPolicy& sp, CellClass cls) {
     const double was = static_cast<double>(*v);
-    *v = storedValue<T>(applyPolicy<P>(pc_, cls, was - offset) + offset);
+    *v = storedValue<T>(applyShifted<P>(sp, cls, was));
     return static_cast<double>(*v) - was;
   }
 
