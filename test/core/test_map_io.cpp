@@ -17,6 +17,7 @@
 #include <functional>
 #include <future>
 #include <iterator>
+#include <type_traits>
 
 #include "map_access.h"
 #include "test_support.h"
@@ -366,14 +367,25 @@ TEST(MapIo, LogOddsTheUpdateCannotCarryAreRefused) {
 TEST(MapIo, AMapLoadedAtTheBoundSavesFilesThatLoad) {
   const double bound = wavog::kMaxStoredLogOdds;
   const std::string at_bound = tempPath("at_bound.wavog"), saved = tempPath("saved_again.wavog");
-  std::size_t nodes = 0;
+  std::size_t coefficients = 0;
   {
     WaveletMap source(params());
     fill(&source, 42);
     auto& im = wavog::MapAccess::impl(source);
-    // Signs alternating by level and child: some cells add every detail on their path.
+    // Signs alternating by level and child: some cells add every detail on their path, and a
+    // tile's cells (storage/tile.h) sit at the bound with alternating signs.
     std::function<void(wavog::detail::Node&, int)> set = [&](wavog::detail::Node& n, int l) {
-      ++nodes;
+      if (im.hasTile(n)) {
+        im.withTile(n, [&](auto& t) {
+          using T = std::remove_reference_t<decltype(t.v[0])>;
+          const T at = wavog::detail::storedValue<T>(bound);  // a float rounds the bound up
+          for (std::size_t i = 0; i < 64; ++i) t.v[i] = i % 3 == 0 ? at : -at;
+          t.base = -bound;
+        });
+        coefficients += 65;
+        return;
+      }
+      ++coefficients;
       const double sign = l % 2 == 0 ? 1.0 : -1.0;
       n.d[0] = sign * bound;
       n.d[1] = -sign * bound;
@@ -390,7 +402,7 @@ TEST(MapIo, AMapLoadedAtTheBoundSavesFilesThatLoad) {
     }
     source.save(at_bound);
   }
-  ASSERT_GT(nodes, 1000u);
+  ASSERT_GT(coefficients, 1000u);
   for (const wavog::PolicyType type : everyPolicyType()) {
     SCOPED_TRACE(wavog::toString(type));
     MapParams p = MapParams::defaultsFor(type);

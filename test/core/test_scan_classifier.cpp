@@ -24,6 +24,7 @@ using wavog::CellClass;
 using wavog::detail::CellMasks;
 using wavog::detail::ScanClassifier;
 using wavog::detail::SquareInfo;
+using wavog::detail::TileMasks;
 
 // Counts of what the walk checked, so the test cannot pass by checking nothing.
 struct Seen {
@@ -54,7 +55,7 @@ class Walk {
       return;
     }
     if (l == 2 && ScanClassifier::fewSectors(info)) expect4x4(ix0, iy0, info);
-    if (l == 3 && ScanClassifier::fewSectors(info)) expect8x8(ix0, iy0, info);
+    if (l == 3) expectTile(ix0, iy0, info);
     const std::int64_t half = std::int64_t{1} << (l - 1);
     for (int q = 0; q < 4; ++q) {
       const std::int64_t cx = ix0 + ((q & 1) ? half : 0), cy = iy0 + ((q & 2) ? half : 0);
@@ -84,13 +85,20 @@ class Walk {
     expectGroup(ix0, iy0, cls_.classify4x4(ix0, iy0, info));
   }
 
-  // classify8x8: its four groups, each against the reference (as the walk hands them to the
-  // level-2 children).
-  void expect8x8(std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
-    ++seen_->groups_8x8;
-    const std::array<CellMasks, 4> m = cls_.classify8x8(ix0, iy0, info);
-    for (std::size_t q = 0; q < 4; ++q) {
-      expectGroup(ix0 + ((q & 1) ? 4 : 0), iy0 + ((q & 2) ? 4 : 0), m[q]);
+  // classifyTileCells: the 64 cells of a tile (as the walk updates them), by row runs where
+  // they lie in few sectors, else by groups or cells.
+  void expectTile(std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
+    if (ScanClassifier::fewSectors(info)) ++seen_->groups_8x8;
+    const TileMasks m = cls_.classifyTileCells(3, ix0, iy0, info);
+    for (unsigned i = 0; i < 64; ++i) {
+      const std::int64_t x = ix0 + (i & 7), y = iy0 + (i >> 3);
+      const CellClass want = ref_.cellClass(x, y);
+      const CellClass got = ((m.e >> i) & 1u)   ? CellClass::kEmpty
+                            : ((m.o >> i) & 1u) ? CellClass::kOccupied
+                                                : CellClass::kUnknown;
+      ASSERT_FALSE(((m.e >> i) & 1u) && ((m.o >> i) & 1u)) << "cell both E and O";
+      ASSERT_EQ(got, want) << "tile at (" << ix0 << ", " << iy0 << "), cell (" << x << ", " << y
+                           << ")";
     }
   }
 

@@ -65,19 +65,20 @@ class ScanClassifier {
   /// classifyCell() for the 16 cells of the 4 x 4 square at (ix0, iy0) classified as `square`
   /// (fewSectors(square)), as masks: bit x + 4 y for cell (ix0 + x, iy0 + y).
   CellMasks classify4x4(std::int64_t ix0, std::int64_t iy0, const SquareInfo& square) const;
-  /// classify4x4() for the four 4 x 4 groups of the 8 x 8 square at (ix0, iy0) classified as
-  /// `square` (fewSectors(square)): group q (x offset 4 (q & 1), y offset 4 (q >> 1)) at [q], as
-  /// classify4x4() gives it. The work per group (offsets, quadrant, coefficients, the hits of the
-  /// square's beams) is done once for the 64 cells.
-  std::array<CellMasks, 4> classify8x8(std::int64_t ix0, std::int64_t iy0,
-                                       const SquareInfo& square) const;
+  /// classifyCell() for the cells of the tile of level t (storage/tile.h: 8 x 8, or 4 x 4 for
+  /// t = 2) at (ix0, iy0) classified as `square`, as masks (bit x + 8 y): by row runs where its
+  /// cells lie in few sectors, else by 4 x 4 groups or cell by cell.
+  TileMasks classifyTileCells(int t, std::int64_t ix0, std::int64_t iy0,
+                              const SquareInfo& square) const;
+  /// classifyCell() for the 16 cells of a 4 x 4 square classified as `square` (any class).
+  CellMasks classifyGroup(std::int64_t ix0, std::int64_t iy0, const SquareInfo& square) const;
 
   /// classifyCell() for the 64 cells of the 8 x 8 square at (ix0, iy0) classified as `square`
   /// (fewSectors(square)), by row runs (scan_classifier_tile_inl.h).
   TileMasks classifyTile(std::int64_t ix0, std::int64_t iy0, const SquareInfo& square) const;
 
   static constexpr int kFewSectors = 32;
-  /// classify8x8() takes the row runs up to this many sector boundaries in the tile, else the
+  /// classifyTileCells() takes the row runs up to this many sector boundaries in the tile, else the
   /// cells one by one: a boundary costs about 70 instructions for the tile's 8 rows, a cell about
   /// 40 (callgrind, fr079 at 5 cm: 10 and 12 both -3.8 % per scan against the row runs alone
   /// without clearing, 10 -1.4 % with 80 m clearing; 8 and 16 less).
@@ -90,7 +91,7 @@ class ScanClassifier {
   };
 
   CellClass cellAt(std::size_t j, double d2) const;
-  static std::uint32_t tileGroup(std::uint64_t v, unsigned shift);
+  static void placeGroup(const CellMasks& g, unsigned shift, TileMasks* m);
   /// Bounds of the squared distances of a tile's cells.
   struct TileRange {
     double lo, hi;

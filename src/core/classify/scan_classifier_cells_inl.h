@@ -95,26 +95,61 @@ inline CellMasks ScanClassifier::classify4x4(std::int64_t ix0, std::int64_t iy0,
   return m;
 }
 
-inline std::array<CellMasks, 4> ScanClassifier::classify8x8(std::int64_t ix0, std::int64_t iy0,
-                                                            const SquareInfo& box) const {
-  std::array<CellMasks, 4> m;
-  if (!box.single && box.shi - box.slo > kTileMaxBoundaries) {  // cell by cell is cheaper
-    classifyGroups<8>(ix0, iy0, box, m.data());
+inline TileMasks ScanClassifier::classifyTileCells(int t, std::int64_t ix0, std::int64_t iy0,
+                                                   const SquareInfo& box) const {
+  TileMasks m;
+  if (box.cls == CellClass::kEmpty) {
+    m.e = t == 3 ? ~std::uint64_t{0} : 0x0F0F0F0Full;
     return m;
   }
-  const TileMasks t = classifyTile(ix0, iy0, box);
+  if (box.cls == CellClass::kUnknown) return m;
+  if (t == 3 && fewSectors(box)) {
+    if (box.single || box.shi - box.slo <= kTileMaxBoundaries) return classifyTile(ix0, iy0, box);
+    std::array<CellMasks, 4> g;  // many boundaries: cell by cell is cheaper
+    classifyGroups<8>(ix0, iy0, box, g.data());
+    for (unsigned q = 0; q < 4; ++q) placeGroup(g[q], 4 * (q & 1) + 32 * (q >> 1), &m);
+    return m;
+  }
+  if (t == 2) {
+    placeGroup(classifyGroup(ix0, iy0, box), 0, &m);
+    return m;
+  }
+  // Many sectors (near the sensor): each 4 x 4 quadrant from its own square class.
   for (unsigned q = 0; q < 4; ++q) {
-    const unsigned shift = 4 * (q & 1) + 32 * (q >> 1);
-    m[q] = {tileGroup(t.e, shift), tileGroup(t.o, shift)};
+    const std::int64_t cx = ix0 + ((q & 1) ? 4 : 0), cy = iy0 + ((q & 2) ? 4 : 0);
+    const SquareInfo sub = classifySquare(2, cx, cy, box);
+    placeGroup(classifyGroup(cx, cy, sub), 4 * (q & 1) + 32 * (q >> 1), &m);
   }
   return m;
 }
 
-/// The 4 x 4 group of tile mask v (bit x + 8 y) whose first cell is bit `shift`, as bits x + 4 y.
-inline std::uint32_t ScanClassifier::tileGroup(std::uint64_t v, unsigned shift) {
-  v >>= shift;
-  return static_cast<std::uint32_t>((v & 0xF) | ((v >> 4) & 0xF0) | ((v >> 8) & 0xF00) |
-                                    ((v >> 12) & 0xF000));
+inline CellMasks ScanClassifier::classifyGroup(std::int64_t ix0, std::int64_t iy0,
+                                               const SquareInfo& box) const {
+  switch (box.cls) {
+    case CellClass::kUnknown:
+      return {};
+    case CellClass::kEmpty:
+      return {0xFFFFu, 0};
+    default:
+      break;
+  }
+  if (fewSectors(box)) return classify4x4(ix0, iy0, box);
+  CellMasks m;
+  for (unsigned i = 0; i < 16; ++i) {
+    const CellClass c = classifyCell(ix0 + (i & 3), iy0 + (i >> 2), box);
+    m.e |= static_cast<std::uint32_t>(c == CellClass::kEmpty) << i;
+    m.o |= static_cast<std::uint32_t>(c == CellClass::kOccupied) << i;
+  }
+  return m;
+}
+
+/// Group masks g (bit x + 4 y) into tile masks (bit x + 8 y) from bit `shift` on.
+inline void ScanClassifier::placeGroup(const CellMasks& g, unsigned shift, TileMasks* m) {
+  const auto spread = [](std::uint64_t v) {
+    return (v & 0xF) | ((v & 0xF0) << 4) | ((v & 0xF00) << 8) | ((v & 0xF000) << 12);
+  };
+  m->e |= spread(g.e) << shift;
+  m->o |= spread(g.o) << shift;
 }
 
 /// The 4 x 4 groups of the kSide x kSide square at (ix0, iy0) (a multiple of 4 each), group

@@ -1,9 +1,13 @@
-// Native map files. Layout (little-endian, version 6):
+// Native map files. Layout (little-endian, version 7):
 //   "WAVOGMAP" | u32 version | f64 resolution | i32 block_levels | f64 prior | f64 a (the factor
 //   one pending unit stands for: 1 - gamma, or 2^-unit with forget_half_life) | u64 block count
 //   per block: i32 bx | i32 by | f64 average | u8 flags (1 known_all, 2 known_any, 4 has_root)
 //              [root subtree, pre-order: f64 dx dy dxy (stored) | u16 pending count k |
-//               u8 child_mask | u8 known_all | u8 known_any | children in q order]
+//               u8 child_mask | u8 known_all | u8 known_any | children in q order; a tile node
+//               (storage/tile.h; child_mask 0x10, at the tile level; a node there may also be
+//               a Haar node with children, made a tile on loading) is followed by its tile:
+//               u64 known | f64 base | f64 cells, row by row (8 x 8, or 4 x 4 in blocks of 2
+//               levels)]
 //   u8 reflection layers, a mask (1: hits, 2: misses; before version 4 their count, hits first),
 //   each: f64 a | u64 block count | blocks as above
 //   u64 count of blocks with normal-distribution cells (MapParams::ndt), each: i32 bx | i32 by |
@@ -14,8 +18,9 @@
 //   each: i32 bx | i32 by | u8 kind (0 counts, 1 ratios, 2 pairs) | u32 n | n cells ascending by
 //   code: u32 code | u32 count, f32 ratio, or f32 hits f32 misses (reflection_store.h)
 //   u32 CRC-32 (IEEE) of every byte before it.
-// Version 5 is the same with f32 details (before issue 37: the nodes held floats). Version 4 is
-// the same without pairs (the clamps counted without bound; such a reflection map
+// Version 6 is the same without tiles (the levels below them are nodes; they are made tiles on
+// loading). Version 5 is the same with f32 details (before issue 37: the nodes held floats).
+// Version 4 is the same without pairs (the clamps counted without bound; such a reflection map
 // restarts on loading). Version 3 (before the hits) is the same without the reflection section (its
 // layers hold the hits and misses: kLayers), version 2 (before ndt) also without the NDT section,
 // version 1 (before forget_half_life and reflection) also with a u8 pending count and no layers;
@@ -32,11 +37,13 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "file/map_codec.h"
 #include "file/map_file.h"
 #include "storage/map_impl.h"
+#include "wavog_mapping/core/haar.h"
 #include "wavog_mapping/core/limits.h"
 #include "wavog_mapping/core/wavelet_map.h"
 
@@ -49,7 +56,7 @@ using detail::Reader;
 using detail::Writer;
 
 constexpr char kMagic[8] = {'W', 'A', 'V', 'O', 'G', 'M', 'A', 'P'};
-constexpr std::uint32_t kVersion = 6;
+constexpr std::uint32_t kVersion = 7;
 constexpr std::uint32_t kOldestVersion = 1;  // u8 pending counts
 // Fixed header: magic, version, resolution, block_levels, prior, forgetting factor, block count.
 constexpr std::size_t kHeaderBytes = sizeof(kMagic) + 4 + 8 + 4 + 8 + 8 + 8;
@@ -81,6 +88,16 @@ void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
   w->put(n.child_mask);
   w->put(static_cast<std::uint8_t>(n.known_all));
   w->put(static_cast<std::uint8_t>(n.known_any));
+  if (WaveletMap::Impl::hasTile(n)) {
+    impl.withTile(n, [&](const auto& t) {
+      w->put(t.known);
+      w->put(t.base);
+      for (std::uint64_t m = detail::tileCells(impl.tile_level); m != 0; m &= m - 1) {
+        w->put(static_cast<double>(t.v[__builtin_ctzll(m)]));
+      }
+    });
+    return;
+  }
   if (l <= 1) return;
   for (int q = 0; q < 4; ++q) {
     if (impl.hasChild(n, q)) writeNode(impl, impl.child(n, q), l - 1, w);
@@ -116,6 +133,83 @@ void checkUniformKnowledge(bool all, bool any) {
   if (all != any) throw std::runtime_error("a uniform slot partly observed");
 }
 
+// Stores `cells` as the tile of node n (a fresh map's), float or wide as the map keeps them.
+void storeTile(WaveletMap::Impl& impl, Node& n, const detail::WideTile& cells) {
+  detail::NodeStore store = impl.serialStore();
+  impl.addTile(store, n);
+  impl.withTile(n, [&](auto& t) {
+    using T = std::remove_reference_t<decltype(t.v[0])>;
+    for (std::size_t i = 0; i < 64; ++i) t.v[i] = detail::storedValue<T>(cells.v[i]);
+    t.known = cells.known;
+    t.base = cells.base;
+  });
+}
+
+// Reads the tile of node n (a fresh map's; its flags read and checked).
+void readTile(WaveletMap::Impl& impl, Node& n, Reader* r) {
+  detail::WideTile t;
+  detail::fillTile(&t, impl.tile_level, false);
+  const std::uint64_t cells = detail::tileCells(impl.tile_level);
+  t.known = r->get<std::uint64_t>();
+  t.base = r->get<double>();
+  if ((t.known & ~cells) != 0) throw std::runtime_error("bad tile cells");
+  if (!std::isfinite(t.base) || std::fabs(t.base) > kMaxStoredLogOdds) {
+    throw std::runtime_error("bad tile base");
+  }
+  for (std::uint64_t m = cells; m != 0; m &= m - 1) {
+    const auto v = r->get<double>();
+    // A cell's value is its node's average plus v - base, each within the bound.
+    if (!std::isfinite(v) || std::fabs(v) > kMaxStoredLogOdds) {
+      throw std::runtime_error(beyondBound("a tile cell", v));
+    }
+    t.v[__builtin_ctzll(m)] = v;
+  }
+  const detail::TileKnowledge k = detail::tileKnowledge(impl.tile_level, t.known);
+  if (k.all != n.known_all || k.any != n.known_any) {
+    throw std::runtime_error("a tile's cells disagree with its node's knowledge");
+  }
+  for (double d : n.d) {
+    if (d != 0.0) throw std::runtime_error("a tile node with details");
+  }
+  storeTile(impl, n, t);
+}
+
+// The cells below node n (level l, first cell (x0, y0) of its tile, average avg, pending
+// multiplier of its details mult) into tile t, with their knowledge.
+void tileCellsOf(const WaveletMap::Impl& impl, const Node& n, int l, unsigned x0, unsigned y0,
+                 double avg, double mult, detail::WideTile* t) {
+  const double d[3] = {n.d[0] * mult, n.d[1] * mult, n.d[2] * mult};
+  const auto c = haar::backward(avg, d);
+  const unsigned half = 1u << (l - 1);
+  for (int q = 0; q < 4; ++q) {
+    const unsigned x = x0 + ((q & 1) ? half : 0), y = y0 + ((q & 2) ? half : 0);
+    const double cq = c[static_cast<std::size_t>(q)];
+    if (l > 1 && impl.hasChild(n, q)) {
+      const Node& ch = impl.child(n, q);
+      tileCellsOf(impl, ch, l - 1, x, y, cq, mult * impl.multiplier(ch.k), t);
+      continue;
+    }
+    const std::uint64_t cells = detail::tileSquare(l - 1, x, y);
+    for (std::uint64_t m = cells; m != 0; m &= m - 1) {
+      t->v[__builtin_ctzll(m)] = cq;
+    }
+    if ((n.known_all >> q) & 1u) t->known |= cells;
+  }
+}
+
+// A node of the tile level read as a Haar node (every file before version 7; a version-7 file
+// may hold one too): n and its subtree become a tile node,
+// its cells at base 0 (their value minus the node's average); n keeps its pending count.
+void makeTile(WaveletMap::Impl& impl, Node& n) {
+  detail::WideTile cells;
+  detail::fillTile(&cells, impl.tile_level, false);
+  tileCellsOf(impl, n, impl.tile_level, 0, 0, 0.0, 1.0, &cells);
+  detail::NodeStore store = impl.serialStore();
+  impl.freeSubtree(store, n);
+  n.d[0] = n.d[1] = n.d[2] = 0.0;
+  storeTile(impl, n, cells);
+}
+
 // Reads a subtree into `impl` (a fresh map); `slot_all` / `slot_any`: the knowledge its slot
 // records. Throws std::runtime_error on inconsistent data.
 // A node's pending count is kept when it means the same for the map (and fits its counts);
@@ -129,24 +223,33 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
     if (std::fabs(d) > kMaxStoredLogOdds) throw std::runtime_error(beyondBound("a detail", d));
   }
   const unsigned k = f.version == 1 ? r->get<std::uint8_t>() : r->get<std::uint16_t>();
+  double applied = 1.0;  // the factor applied now (a tile's too)
   if (f.same_unit && pending == 0 && k <= impl.k_cap) {
     n.k = static_cast<std::uint16_t>(k);
   } else {
     pending += k;
-    const double m = std::pow(f.file_a, static_cast<double>(pending));
-    for (double& d : n.d) d *= m;
+    applied = std::pow(f.file_a, static_cast<double>(pending));
+    for (double& d : n.d) d *= applied;
     n.k = 0;
   }
   const auto mask = r->get<std::uint8_t>();
   const auto known_all = r->get<std::uint8_t>();
   const auto known_any = r->get<std::uint8_t>();
-  if (mask > 0xF || known_all > 0xF || known_any > 0xF || (known_all & ~known_any) != 0) {
+  const bool tile = mask == detail::kTileBit && f.version >= 7;
+  if ((mask > 0xF && !tile) || known_all > 0xF || known_any > 0xF ||
+      (known_all & ~known_any) != 0) {
     throw std::runtime_error("bad node flags");
   }
   n.known_all = known_all & 0xFu;
   n.known_any = known_any & 0xFu;
   if (l == 1 && mask != 0) throw std::runtime_error("children below level 1");
   checkSlotKnowledge(slot_all, slot_any, known_all, known_any);
+  if (tile) {
+    if (l != impl.tile_level) throw std::runtime_error("a tile off the tile level");
+    readTile(impl, n, r);
+    if (applied != 1.0) impl.withTile(n, [&](auto& t) { detail::scaleTile(&t, applied); });
+    return;
+  }
   for (int q = 0; q < 4; ++q) {
     const bool all = (known_all >> q) & 1u, any = (known_any >> q) & 1u;
     if (!((mask >> q) & 1u)) {
@@ -156,6 +259,7 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
     Node& c = impl.installChild(n, q, Node{});
     readNode(impl, c, l - 1, f, pending, all, any, r);
   }
+  if (l == impl.tile_level) makeTile(impl, n);
 }
 
 // Opens `path` (a regular file only) and reads it whole, once its header says it is a map of this
@@ -249,7 +353,7 @@ void readBlocks(WaveletMap::Impl& fresh, const PendingFormat& format, std::size_
     b.known_any = (flags & 2) != 0;
     b.has_root = (flags & 4) != 0;
     if (b.has_root) {
-      ++fresh.nodes;
+      ++fresh.counts.nodes;
       readNode(fresh, b.root, fresh.levels, format, 0, b.known_all, b.known_any, r);
     } else {
       checkUniformKnowledge(b.known_all, b.known_any);

@@ -1,8 +1,10 @@
 // Region clearing of WaveletMap: clearBox() sets every finest cell of a rectangle back to the
 // prior and unobserved, block by block and coarse to fine, pruning what becomes trivial; its
 // normal-distribution cells (MapParams::ndt) and hits (MapParams::reflection) go too.
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "update/map_slot.h"
@@ -21,11 +23,40 @@ struct ClearBox {
   std::int64_t x0, y0, x1, y1;  // inclusive finest-cell bounds
 };
 
+// clearNode() of a tile node (tag flushed; a uniform one is given a tile first).
+double clearTile(WaveletMap::Impl& impl, detail::NodeStore& store, Node& n, std::int64_t ix0,
+                 std::int64_t iy0, double s, const ClearBox& box) {
+  if (!impl.hasTile(n)) impl.addTile(store, n);
+  const std::int64_t side = std::int64_t{1} << impl.tile_level;
+  const std::int64_t x0 = std::max(box.x0, ix0) - ix0, x1 = std::min(box.x1, ix0 + side - 1) - ix0;
+  const std::int64_t y0 = std::max(box.y0, iy0) - iy0, y1 = std::min(box.y1, iy0 + side - 1) - iy0;
+  const double ds = impl.withTile(n, [&](auto& t) {
+    using T = std::remove_reference_t<decltype(t.v[0])>;
+    const double offset = t.base - s;  // stored value of a cell minus its value
+    double sum = 0.0;
+    for (std::int64_t y = y0; y <= y1; ++y) {
+      for (std::int64_t x = x0; x <= x1; ++x) {
+        T& v = t.v[x + 8 * y];
+        const T now = detail::storedValue<T>(impl.init + offset);
+        sum += static_cast<double>(now) - static_cast<double>(v);
+        v = now;
+        t.known &= ~(std::uint64_t{1} << (x + 8 * y));
+      }
+    }
+    const double change = sum / static_cast<double>(side * side);
+    t.base = detail::keepStored(t.base + change);
+    return change;
+  });
+  impl.dropTileIfUniform(store, n);
+  return ds;
+}
+
 // Sets every finest cell of the box inside node `n` (level l, origin ix0/iy0, average s) back to
 // the prior and unobserved. Returns the change of n's average.
 double clearNode(WaveletMap::Impl& impl, detail::NodeStore& store, Node& n, int l, std::int64_t ix0,
                  std::int64_t iy0, double s, const ClearBox& box) {
   impl.flush(n);
+  if (l == impl.tile_level) return clearTile(impl, store, n, ix0, iy0, s, box);
   const auto c = haar::backward(s, n.d);
   std::array<double, 4> delta{};
   const std::int64_t half = std::int64_t{1} << (l - 1);
@@ -98,7 +129,7 @@ std::size_t WaveletMap::clearBox(double min_x, double min_y, double max_x, doubl
       b.hits->pairs.removeIf(in_box);
     }
     // The block's groups stay with it (as in an integration, see NodeStore).
-    detail::NodeStore store(impl.pool, &b.spare, &impl.nodes, impl.pool.liveCounter());
+    detail::NodeStore store(impl.pool, impl.tiles, &b.spare, &impl.counts);
     detail::RootSlot slot(impl, store, b);
     const double s = b.s;
     const double ds = detail::refineSlot(

@@ -10,6 +10,11 @@ using detail::Node;
 
 namespace {
 std::uint64_t countObserved(const WaveletMap::Impl& impl, const Node& n, int l) {
+  if (impl.hasTile(n)) {
+    const std::uint64_t known = impl.withTile(n, [](const auto& t) { return t.known; });
+    return static_cast<std::uint64_t>(
+        __builtin_popcountll(known & detail::tileCells(impl.tile_level)));
+  }
   std::uint64_t count = 0;
   for (int q = 0; q < 4; ++q) {
     if (l > 1 && impl.hasChild(n, q)) {
@@ -26,7 +31,7 @@ MapStats WaveletMap::stats(bool count_observed) const {
   const Impl& impl = *impl_;
   MapStats st;
   st.blocks = impl.blocks.size();
-  st.nodes = impl.nodes;
+  st.nodes = impl.counts.nodes;
   // Hash: one heap node per block (key, Block, next pointer, cached hash) plus the bucket array.
   const std::size_t per_block = sizeof(std::uint64_t) + sizeof(Block) + 2 * sizeof(void*);
   // The blocks' spare node groups are chained in the pool's chunks (bytes_reserved).
@@ -48,8 +53,10 @@ MapStats WaveletMap::stats(bool count_observed) const {
     st.ndt_cells += ndt->entries.size() - ndt->dead;
     st.ndt_bytes += sizeof(detail::NdtCells) + ndt->entries.capacity() * sizeof(detail::NdtEntry);
   }
-  st.bytes = impl.pool.bytes() + rest + st.ndt_bytes + hit_bytes;
-  st.bytes_reserved = impl.pool.bytesReserved() + rest + st.ndt_bytes + hit_bytes;
+  st.bytes = impl.pool.bytes(impl.counts.groups) + impl.tiles.bytes(impl.counts.tiles) + rest +
+             st.ndt_bytes + hit_bytes;
+  st.bytes_reserved =
+      impl.pool.bytesReserved() + impl.tiles.bytesReserved() + rest + st.ndt_bytes + hit_bytes;
   st.nodes_visited_last = impl.nodes_visited_last;
   for (const WaveletMap* layer : {impl.hits_layer.get(), impl.misses_layer.get()}) {
     if (layer == nullptr) continue;

@@ -43,6 +43,10 @@ class RasterWriter {
       return;
     }
     const double m = mult * impl_.multiplier(n->k);
+    if (impl_.hasTile(*n)) {
+      impl_.withTile(*n, [&](const auto& t) { tile(t, l, ix0, iy0, avg, m); });
+      return;
+    }
     const double d[3] = {n->d[0] * m, n->d[1] * m, n->d[2] * m};
     const auto c = haar::backward(avg, d);
     const std::int64_t half = std::int64_t{1} << (l - 1);
@@ -55,9 +59,38 @@ class RasterWriter {
   }
 
  private:
+  // The raster cells of a tile of level l > s_ (origin ix0, iy0; its node's average avg, the
+  // factor of its values m): each the mean, or the max over the observed, of its cells.
+  template <typename Tile>
+  void tile(const Tile& t, int l, std::int64_t ix0, std::int64_t iy0, double avg, double m) {
+    const unsigned side = 1u << s_, n = 1u << l;
+    for (unsigned y = 0; y < n; y += side) {
+      for (unsigned x = 0; x < n; x += side) {
+        const std::uint64_t cells = detail::tileSquare(s_, x, y), known = t.known & cells;
+        float v = static_cast<float>(avg + m * (detail::tileMean(t, cells) - t.base));
+        if (agg_ == Aggregation::kMax) v = maxOf(t, known, avg, m);
+        fill((ix0 + x) >> s_, (iy0 + y) >> s_, 1, v, known != 0);
+      }
+    }
+  }
+
+  // Max over the cells `known` of a tile (its node's average avg, the factor of its values m).
+  template <typename Tile>
+  static float maxOf(const Tile& t, std::uint64_t known, double avg, double m) {
+    float best = kNoObservedCell;
+    for (; known != 0; known &= known - 1) {
+      const double v = avg + m * (t.v[__builtin_ctzll(known)] - t.base);
+      best = std::max(best, static_cast<float>(v));
+    }
+    return best;
+  }
+
   // Max over the observed finest cells below node n (level l, average avg).
   float maxObserved(const Node& n, int l, double avg, double mult) const {
     const double m = mult * impl_.multiplier(n.k);
+    if (impl_.hasTile(n)) {
+      return impl_.withTile(n, [&](const auto& t) { return maxOf(t, t.known, avg, m); });
+    }
     const double d[3] = {n.d[0] * m, n.d[1] * m, n.d[2] * m};
     const auto c = haar::backward(avg, d);
     float best = kNoObservedCell;

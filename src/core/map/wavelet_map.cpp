@@ -48,6 +48,17 @@ WaveletMap::Impl::SlotRead WaveletMap::Impl::read(int s, std::int64_t x, std::in
   double mult = 1.0;
   for (int l = levels; l > s; --l) {
     mult *= multiplier(n->k);
+    if (hasTile(*n)) {
+      // The square of side 2^s holding the cell, within the tile (l = tile_level).
+      const std::int64_t mask = (std::int64_t{1} << l) - 1;
+      const std::uint64_t cells =
+          detail::tileSquare(s, static_cast<unsigned>(fx & mask), static_cast<unsigned>(fy & mask));
+      return withTile(*n, [&](const auto& t) {
+        const std::uint64_t known = t.known & cells;
+        return SlotRead{avg + mult * (detail::tileMean(t, cells) - t.base), known == cells,
+                        known != 0};
+      });
+    }
     const int q = static_cast<int>(((fx >> (l - 1)) & 1) | (((fy >> (l - 1)) & 1) << 1));
     const double d[3] = {n->d[0] * mult, n->d[1] * mult, n->d[2] * mult};
     avg = haar::backwardChild(avg, d, q);
@@ -76,7 +87,8 @@ bool WaveletMap::isObserved(const CellIndex& cell) const { return lookup(*impl_,
 void WaveletMap::reset() {
   impl_->blocks.clear();
   impl_->pool.clear();
-  impl_->nodes = 0;
+  impl_->tiles.clear();
+  impl_->counts = detail::StoreCounts{};
   impl_->restartReflection(true);  // the occupancy is empty again
 }
 

@@ -28,12 +28,11 @@ struct Block {
   bool has_root = false;   ///< false: the block is uniform at s
   bool known_all = false;  ///< every cell observed
   bool known_any = false;  ///< some cell observed
-  /// Node groups this block freed during integrations, reused by its next ones: the first of a
-  /// spare list (NodePool::pushSpare), 0 when empty.
-  std::uint32_t spare = 0;
+  /// Node groups and tiles this block freed during integrations, reused by its next ones.
+  Spares spare;
   /// The spare lists of the block's parts (update/split_plan.h: the slots split_levels below
   /// its root, which threads update apart).
-  std::array<std::uint32_t, kMaxBlockParts> part_spare{};
+  std::array<Spares, kMaxBlockParts> part_spare{};
   /// MapParams::ndt: the Gaussians of its cells (made with the first end-point in the block).
   std::unique_ptr<NdtCells> ndt;
   /// MapParams::reflection: the hits of its cells (made with the first hit in the block).

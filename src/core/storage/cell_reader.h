@@ -37,6 +37,12 @@ class BlockCellReader {
     last_ = code;
     for (;; --l) {
       const Step& st = path_[l];
+      if (WaveletMap::Impl::hasTile(*st.n)) {
+        reached_ = l;
+        return impl_.withTile(*st.n, [&](const auto& t) {
+          return st.avg + st.mult * (t.v[kTileMorton.cell[code & 63u]] - t.base);
+        });
+      }
       const int q = static_cast<int>((code >> (2 * (l - 1))) & 3u);
       const double d[3] = {st.n->d[0] * st.mult, st.n->d[1] * st.mult, st.n->d[2] * st.mult};
       const double avg = haar::backwardChild(st.avg, d, q);

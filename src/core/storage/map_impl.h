@@ -80,6 +80,9 @@ struct WaveletMap::Impl {
   double unitFactor() const { return half_life ? std::exp2(-unit_log2) : a; }
 
   detail::NodePool pool;
+  detail::TilePool tiles;
+  /// The level of the tile nodes (storage/tile.h): 3, or 2 in blocks of 2 levels.
+  int tile_level = 3;
   detail::BlockMap blocks;
   /// Worker threads of parallel integrations (num_threads != 1), made on the first one.
   std::unique_ptr<detail::WorkerPool> workers;
@@ -105,7 +108,7 @@ struct WaveletMap::Impl {
     detail::mortonCell(code, &lx, &ly);
     return unhitMisses(ix0 + lx, iy0 + ly, l);
   }
-  std::size_t nodes = 0;  ///< live nodes (roots included)
+  detail::StoreCounts counts;  ///< live nodes (roots included), node groups and tiles
   std::uint64_t nodes_visited_last = 0;
 
   /// Recomputes a, the pending units and their multipliers, k_star, init from params (policy
@@ -117,9 +120,46 @@ struct WaveletMap::Impl {
     return pool.group(n.children).n[q];
   }
   bool hasChild(const detail::Node& n, int q) const { return (n.child_mask >> q) & 1u; }
+  /// A tile node's cells (storage/tile.h).
+  static bool hasTile(const detail::Node& n) { return (n.child_mask & detail::kTileBit) != 0; }
+  /// Returns f(tile) for the tile of node n, a FloatTile or a WideTile (tiles.wide()).
+  template <typename F>
+  decltype(auto) withTile(const detail::Node& n, F&& f) {
+    if (tiles.wide()) return f(tiles.wideTiles().group(n.children));
+    return f(tiles.narrow().group(n.children));
+  }
+  template <typename F>
+  decltype(auto) withTile(const detail::Node& n, F&& f) const {
+    if (tiles.wide()) return f(tiles.wideTiles().group(n.children));
+    return f(tiles.narrow().group(n.children));
+  }
+  /// Gives node n (tag flushed, no children) a tile, uniform at its average, observed as its
+  /// knowledge bits say.
+  void addTile(detail::NodeStore& store, detail::Node& n) {
+    n.children = store.allocateTile();
+    n.child_mask = detail::kTileBit;
+    withTile(n, [&](auto& t) { detail::fillTile(&t, tile_level, n.known_any != 0); });
+  }
+  /// Frees the tile of node n when it carries nothing beyond n's average (tileUniform): n then
+  /// has no children, and its knowledge bits are those of the tile.
+  void dropTileIfUniform(detail::NodeStore& store, detail::Node& n) {
+    const bool uniform = withTile(n, [&](const auto& t) {
+      const detail::TileKnowledge k = detail::tileKnowledge(tile_level, t.known);
+      n.known_all = k.all & 0xFu;  // 4-bit masks
+      n.known_any = k.any & 0xFu;
+      return detail::tileUniform(t, tile_level, prune_threshold);
+    });
+    if (!uniform) return;
+    store.releaseTile(n.children);
+    n.children = 0;
+    n.child_mask = 0;
+  }
+  /// Makes every tile float, or wide (storage/tile.h), as the policy needs (configure()).
+  void setTileKind(bool wide);
 
-  /// Node groups and counts for one thread at a time: the pool's own free list, the map's counts.
-  detail::NodeStore serialStore() { return {pool, nullptr, &nodes, pool.liveCounter()}; }
+  /// Node groups and counts for one thread at a time: the pools' own free lists, the map's
+  /// counts.
+  detail::NodeStore serialStore() { return {pool, tiles, nullptr, &counts}; }
 
   /// Installs `m` as child q of `n` (allocating the group if needed); returns the stored node.
   detail::Node& installChild(detail::NodeStore& store, detail::Node& n, int q,
@@ -220,7 +260,9 @@ inline void WaveletMap::Impl::flush(detail::Node& n) {
   if (n.k == 0) return;
   const double m = multiplier(n.k);
   for (double& d : n.d) d *= m;
-  if (n.children != 0) {
+  if (hasTile(n)) {
+    withTile(n, [m](auto& t) { detail::scaleTile(&t, m); });
+  } else if (n.children != 0) {
     for (int q = 0; q < 4; ++q) {
       if (hasChild(n, q)) addPending(child(n, q), n.k);
     }

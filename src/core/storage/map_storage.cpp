@@ -2,6 +2,8 @@
 // creation and deletion, flushing every lazy tag, block lookup and creation.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <type_traits>
 
 #include "storage/map_impl.h"
 
@@ -11,18 +13,22 @@ using detail::Block;
 using detail::Node;
 
 namespace {
-// Spare groups a new block takes from the pool's own free list.
-constexpr std::size_t kLentGroups = 64;
+// Spare groups and tiles a new block takes from the pools' own free lists.
+constexpr std::size_t kLentGroups = 64, kLentTiles = 16;
 }  // namespace
 
 WaveletMap::Impl::Impl(const MapParams& p, bool validate) : params(p) {
   if (validate) throwIfInvalid(p);
   levels = p.grid.block_levels;
+  tile_level = detail::tileLevel(levels);
   configure();
   restartReflection(true);
 }
 
 void WaveletMap::Impl::configure() {
+  const PolicyType type = params.policy.type;
+  setTileKind(type == PolicyType::kNone || type == PolicyType::kClampLower ||
+              type == PolicyType::kClampUpper);
   init = params.initValue();
   const bool forget = params.policy.type == PolicyType::kForget;
   a = forget ? 1.0 - params.policy.gamma : 1.0;
@@ -91,6 +97,12 @@ std::uint64_t WaveletMap::Impl::scanUnits(double period) const {
 
 void WaveletMap::Impl::freeSubtree(detail::NodeStore& store, Node& n) {
   if (n.children == 0) return;
+  if (hasTile(n)) {
+    store.releaseTile(n.children);
+    n.children = 0;
+    n.child_mask = 0;
+    return;
+  }
   for (int q = 0; q < 4; ++q) {
     if (hasChild(n, q)) {
       freeSubtree(store, child(n, q));
@@ -110,6 +122,54 @@ void WaveletMap::Impl::removeChild(detail::NodeStore& store, Node& n, int q) {
     store.release(n.children);
     n.children = 0;
   }
+}
+
+namespace {
+// Calls f(n) for every tile node of the subtree of n.
+template <typename F>
+void forEachTileNode(WaveletMap::Impl& impl, Node& n, F& f) {
+  if (WaveletMap::Impl::hasTile(n)) {
+    f(n);
+    return;
+  }
+  if (n.children == 0) return;
+  for (int q = 0; q < 4; ++q) {
+    if (impl.hasChild(n, q)) forEachTileNode(impl, impl.child(n, q), f);
+  }
+}
+
+// Copies the tile of node n from pool `from` into a new one of pool `to`.
+template <typename From, typename To>
+void moveTile(Node& n, detail::ChunkPool<From>& from, detail::ChunkPool<To>& to) {
+  using T = std::remove_reference_t<decltype(To{}.v[0])>;
+  const std::uint32_t i = to.allocate(false);
+  const From& a = from.group(n.children);
+  To& b = to.group(i);
+  for (std::size_t c = 0; c < 64; ++c) b.v[c] = detail::storedValue<T>(a.v[c]);
+  b.known = a.known;
+  b.base = a.base;
+  from.release(n.children);
+  n.children = i;
+}
+}  // namespace
+
+void WaveletMap::Impl::setTileKind(bool wide) {
+  if (wide == tiles.wide()) return;
+  for (auto& kv : blocks) {
+    tiles.recycleSpares(&kv.second.spare.tiles);
+    for (detail::Spares& part : kv.second.part_spare) tiles.recycleSpares(&part.tiles);
+  }
+  auto convert = [&](Node& n) {
+    if (wide) {
+      moveTile(n, tiles.narrow(), tiles.wideTiles());
+    } else {
+      moveTile(n, tiles.wideTiles(), tiles.narrow());
+    }
+  };
+  for (auto& kv : blocks) {
+    if (kv.second.has_root) forEachTileNode(*this, kv.second.root, convert);
+  }
+  tiles.setWide(wide);
 }
 
 namespace {
@@ -143,7 +203,8 @@ Block& WaveletMap::Impl::getOrCreateBlock(std::int64_t bx, std::int64_t by) {
   if (res.second) {
     res.first->second.s = init;
     // Groups of erased blocks go to new ones (integrations take only their block's spares).
-    pool.lend(kLentGroups, &res.first->second.spare);
+    pool.lend(kLentGroups, &res.first->second.spare.groups);
+    tiles.lend(kLentTiles, &res.first->second.spare.tiles);
   }
   return res.first->second;
 }
@@ -160,8 +221,12 @@ void WaveletMap::Impl::dropIfEmpty(std::int64_t bx, std::int64_t by) {
 void WaveletMap::Impl::eraseBlock(std::uint64_t key) {
   auto it = blocks.find(key);
   if (it == blocks.end()) return;
-  pool.recycleSpares(&it->second.spare);
-  for (std::uint32_t& part : it->second.part_spare) pool.recycleSpares(&part);
+  const auto recycle = [this](detail::Spares* sp) {
+    pool.recycleSpares(&sp->groups);
+    tiles.recycleSpares(&sp->tiles);
+  };
+  recycle(&it->second.spare);
+  for (detail::Spares& part : it->second.part_spare) recycle(&part);
   blocks.erase(it);
 }
 

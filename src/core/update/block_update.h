@@ -111,8 +111,13 @@ inline void lendSparesToParts(WaveletMap::Impl& impl, SplitPlan* plan) {
     Block* b = plan->tasks[plan->parts[first]].block;
     std::size_t end = first + 1;
     while (end < n && plan->tasks[plan->parts[end]].block == b) ++end;
-    for (std::size_t i = first; b->spare != 0; i = i + 1 < end ? i + 1 : first) {
-      impl.pool.pushSpare(plan->tasks[plan->parts[i]].spare, impl.pool.popSpare(&b->spare));
+    for (std::size_t i = first; b->spare.groups != 0; i = i + 1 < end ? i + 1 : first) {
+      impl.pool.pushSpare(&plan->tasks[plan->parts[i]].spare->groups,
+                          impl.pool.popSpare(&b->spare.groups));
+    }
+    for (std::size_t i = first; b->spare.tiles != 0; i = i + 1 < end ? i + 1 : first) {
+      impl.tiles.pushSpare(&plan->tasks[plan->parts[i]].spare->tiles,
+                           impl.tiles.popSpare(&b->spare.tiles));
     }
     first = end;
   }

@@ -197,7 +197,7 @@ std::uint64_t runOnWorkers(WaveletMap::Impl& impl, detail::WorkerPool& workers, 
                            Work work) {
   struct alignas(64) Tally {
     std::uint64_t visited = 0;
-    std::size_t nodes = 0, groups = 0;
+    detail::StoreCounts counts;
   };
   std::vector<Tally> tallies(static_cast<std::size_t>(workers.threads()));
   const auto active = static_cast<std::size_t>(threads);
@@ -205,14 +205,15 @@ std::uint64_t runOnWorkers(WaveletMap::Impl& impl, detail::WorkerPool& workers, 
     const auto tu = static_cast<std::size_t>(t);
     if (tu >= active) return;
     Tally& tally = tallies[tu];
-    detail::NodeStore store(impl.pool, nullptr, &tally.nodes, &tally.groups);
+    detail::NodeStore store(impl.pool, impl.tiles, nullptr, &tally.counts);
     tally.visited = work(store);
   });
   std::uint64_t visited = 0;
   for (const Tally& tally : tallies) {
     visited += tally.visited;
-    impl.nodes += tally.nodes;
-    impl.pool.addLive(tally.groups);
+    impl.counts.nodes += tally.counts.nodes;
+    impl.counts.groups += tally.counts.groups;
+    impl.counts.tiles += tally.counts.tiles;
   }
   return visited;
 }
@@ -276,7 +277,7 @@ std::uint64_t integrateSplit(WaveletMap::Impl& impl, const ScanClassifier& cls,
   thread_local detail::SplitPlan plan_buffer;  // reused from scan to scan
   detail::SplitPlan& plan = plan_buffer;        // the workers read this thread's copy
   plan.clear();
-  detail::NodeStore serial(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
+  detail::NodeStore serial = impl.serialStore();
   std::uint64_t visited = detail::planBlocks<P>(impl, serial, cls, pc, jobs, split, &plan);
   detail::lendSparesToParts(impl, &plan);
   std::atomic<std::size_t> next{0};
@@ -374,6 +375,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
   // does not depend on which thread updates which block, nor in which order.
   // The chunk table grows here, whatever the thread count, so that its size does not depend on it.
   impl.pool.reserveFresh(jobs.size() * maxGroupsPerBlock(L));
+  impl.tiles.reserveFresh(jobs.size() * (std::size_t{1} << (2 * (L - impl.tile_level))));
   // Without payloads the blocks of a scan of few blocks are split below their roots, so that
   // threads share a block (split_plan.h); the same whatever the thread count.
   const int split = ndt == nullptr && hits == nullptr && jobs.size() <= detail::kSplitMaxBlocks
@@ -383,7 +385,7 @@ std::uint64_t integrateAll(WaveletMap::Impl& impl, const ScanClassifier& cls, do
   std::atomic<std::size_t> next{0};
   const int threads = workersFor(impl, jobs.size(), workers);
   if (threads <= 1) {
-    detail::NodeStore store(impl.pool, nullptr, &impl.nodes, impl.pool.liveCounter());
+    detail::NodeStore store = impl.serialStore();
     return visited + updateBlocksFor<P>(impl, store, cls, pc, ndt, hits, jobs, &next);
   }
   orderByWork(ps, block_size, &jobs);

@@ -274,12 +274,8 @@ class Integrator {
     ++visited_;
     impl_.flush(n);
     // The children are read after the (long) classification: fetch them meanwhile.
+    if (l == impl_.tile_level) return visitTile(n, box, ix0, iy0, s);
     if (n.children != 0) impl_.pool.prefetch(n.children);
-    if (l == 1) return visitLeafParent(n, box, ix0, iy0, s);
-    if (l == 2 && ScanClassifier::fewSectors(box)) {
-      return visitGroup(n, box, cls_.classify4x4(ix0, iy0, box), s, ix0, iy0);
-    }
-    if (l == 3 && ScanClassifier::fewSectors(box)) return visitLevel3(n, box, ix0, iy0, s);
     const std::array<double, 4> c = haar::backward(s, n.d);
     std::array<double, 4> delta{};
     Spans parts{};
@@ -303,142 +299,76 @@ class Integrator {
     return foldChanges(n, delta);
   }
 
-  // A level-1 node: its children are finest cells.
-  double visitLeafParent(Node& n, const SquareInfo& box, std::int64_t ix0, std::int64_t iy0,
-                         double s) {
-    CellMasks cells;
-    for (unsigned q = 0; q < 4; ++q) {
-      const CellClass cls = cls_.classifyCell(ix0 + static_cast<std::int64_t>(q & 1),
-                                              iy0 + static_cast<std::int64_t>(q >> 1), box);
-      cells.e |= static_cast<std::uint32_t>(cls == CellClass::kEmpty) << q;
-      cells.o |= static_cast<std::uint32_t>(cls == CellClass::kOccupied) << q;
-    }
-    return updateCells(n, cells, s, ix0, iy0);
-  }
-
-  // Applies the policy to the 4 finest cells of level-1 node n (average s, tag flushed), cell q
-  // E or O by bit q of `cells` (U when in neither), and to the Gaussians of those cells (the
-  // slot's span); with kHits, lists its O cells (codes slot_code_ + q); returns the change of n's
-  // average. Its first cell (ix0, iy0) is not read: GCC 12 compiles the walk without hits as it
-  // did only with them there (80 m / 5 cm clamp, 300 scans: 19,394 M instructions, 19,474 M
-  // without); inlined, the walk with hits is 1.7 % shorter.
-  [[gnu::always_inline]] double updateCells(Node& n, const CellMasks& cells, double s,
-                                            [[maybe_unused]] std::int64_t ix0,
-                                            [[maybe_unused]] std::int64_t iy0) {
-    visited_ += 4;
+  // A tile node n (tag flushed; storage/tile.h), average s, cells classified together
+  // (classifyTileCells): the policy applied to its E and O cells, its Gaussians of observed cells
+  // forgotten (kNdt), its O cells listed (kHits); the tile made if n had none, freed if it became
+  // uniform. Returns the change of n's average.
+  [[gnu::noinline]] double visitTile(Node& n, const SquareInfo& box, std::int64_t ix0,
+                                     std::int64_t iy0, double s) {
+    const int t = impl_.tile_level;
+    const TileMasks cells = cls_.classifyTileCells(t, ix0, iy0, box);
+    const std::uint64_t observed = cells.e | cells.o;
+    visited_ += cellCount(observed);
     if constexpr (kNdt) {
-      const std::uint32_t observed = cells.e | cells.o;
       slot_span_.forEach([&](NdtEntry* x) {
-        if ((observed >> (x->code & 3u)) & 1u) ndt_->forget(x);
+        if ((observed >> kTileMorton.cell[x->code & 63u]) & 1u) ndt_->forget(x);
       });
     }
-    const std::array<double, 4> c = haar::backward(s, n.d);
-    std::array<double, 4> delta{};
-    for (std::size_t q = 0; q < 4; ++q) {
-      if ((cells.e >> q) & 1u) {
-        delta[q] = applyPolicy<P>(pc_, CellClass::kEmpty, c[q]) - c[q];
-      } else if ((cells.o >> q) & 1u) {
-        delta[q] = applyPolicy<P>(pc_, CellClass::kOccupied, c[q]) - c[q];
+    if (observed == 0) return 0.0;
+    if (!WaveletMap::Impl::hasTile(n)) impl_.addTile(store_, n);
+    const double ds = impl_.withTile(n, [&](auto& tile) {
+      // A cell's value is s + (v - base): stored value minus `offset`.
+      const double offset = tile.base - s;
+      const ShiftedPolicy sp = shiftPolicy<P>(pc_, offset);
+      double sum = 0.0;
+      std::uint64_t e = cells.e;
+      for (unsigned row = 0; row < 64; row += 8) {
+        // A row all E (most rows of the cleared space) without a bit scan.
+        if (((e >> row) & 0xFFu) != 0xFFu) continue;
+        for (unsigned x = 0; x < 8; ++x) {
+          sum += updateCell(&tile.v[row + x], sp, CellClass::kEmpty);
+        }
+        e &= ~(std::uint64_t{0xFF} << row);
       }
-    }
-    if constexpr (kHits) {
-      // slot_code_: this level-1 node's first cell, entered by its parent.
-      for (std::uint32_t o = cells.o; o != 0; o &= o - 1) {
-        const auto q = static_cast<unsigned>(__builtin_ctz(o));
-        observed_->push_back({slot_code_ + q, c[q]});
+      for (std::uint64_t m = e; m != 0; m &= m - 1) {
+        sum += updateCell(&tile.v[__builtin_ctzll(m)], sp, CellClass::kEmpty);
       }
-    }
-    const auto known = static_cast<std::uint8_t>(cells.e | cells.o);
-    n.known_all = (n.known_all | known) & 0xFu;  // 4-bit masks
-    n.known_any = (n.known_any | known) & 0xFu;
-    return foldChanges(n, delta);
+      for (std::uint64_t m = cells.o; m != 0; m &= m - 1) {
+        const auto i = static_cast<unsigned>(__builtin_ctzll(m));
+        if constexpr (kHits) {
+          observed_->push_back({slot_code_ + kTileMorton.code[i], tile.v[i] - offset});
+        }
+        sum += updateCell(&tile.v[i], sp, CellClass::kOccupied);
+      }
+      tile.known |= observed;
+      // The cells' mean moved by the change: so does base, and the unobserved cells keep their
+      // stored values.
+      const double change = sum / static_cast<double>(std::uint64_t{1} << (2 * t));
+      tile.base = keepStored(tile.base + change);
+      return change;
+    });
+    impl_.dropTileIfUniform(store_, n);
+    return ds;
   }
 
-  // A level-3 node (8 x 8 finest cells, tag flushed) whose cells lie in one or a few sectors:
-  // its 64 cells are classified in one pass (classify8x8: the work per group shared), and each
-  // level-2 child slot takes the exact class of its 16 cells instead of a conservative square test
-  // of its own (fewer children refined: a square test can say MIXED of all-E or all-U cells), and
-  // is updated from them (visitGroup). A child that the square test would have skipped has its
-  // cells classified for nothing; on fr079 the sum still pays (docs/compare.md).
-  [[gnu::noinline]] double visitLevel3(Node& n, const SquareInfo& box, std::int64_t ix0,
-                                       std::int64_t iy0, double s) {
-    [[maybe_unused]] const std::uint32_t code = slot_code_;  // kHits: its first cell
-    const std::array<CellMasks, 4> groups = cls_.classify8x8(ix0, iy0, box);
-    const std::array<double, 4> c = haar::backward(s, n.d);
-    std::array<double, 4> delta{};
-    Spans parts{};
-    if constexpr (kNdt) slot_span_.split(3, parts.data());
-    for (int q = 0; q < 4; ++q) {
-      const auto qu = static_cast<std::size_t>(q);
-      ++visited_;
-      const CellClass cq = groupClass(groups[qu]);
-      if (cq == CellClass::kUnknown) continue;
-      const std::int64_t cx = ix0 + ((q & 1) ? 4 : 0), cy = iy0 + ((q & 2) ? 4 : 0);
-      ChildSlot slot(impl_, store_, n, q);
-      if constexpr (kNdt) enterSlot(parts[qu], box);
-      if constexpr (kHits) enterCells(code + (static_cast<std::uint32_t>(q) << 4));
-      delta[qu] = updateSlot(slot, cq, c[qu], [&](Node& m) {
-        ++visited_;
-        impl_.flush(m);
-        if (m.children != 0) impl_.pool.prefetch(m.children);
-        return visitGroup(m, box, groups[qu], c[qu], cx, cy);
-      });
-    }
-    return foldChanges(n, delta);
-  }
-
-  // A level-2 node (4 x 4 finest cells, tag flushed) whose 16 cells have the classes `cells`
-  // (classified together, cheaply when the square lies in one or a few sectors; cell (x, y) at
-  // bit x + 4 y): each level-1 child slot takes the class of its 4 cells, exactly, instead of a
-  // conservative square test of its own.
-  [[gnu::noinline]] double visitGroup(Node& n, const SquareInfo& box, const CellMasks& cells,
-                                      double s, std::int64_t ix0, std::int64_t iy0) {
-    [[maybe_unused]] const std::uint32_t code = slot_code_;  // kHits: its first cell
-    const std::array<double, 4> c = haar::backward(s, n.d);
-    std::array<double, 4> delta{};
-    Spans parts{};
-    if constexpr (kNdt) slot_span_.split(2, parts.data());
-    for (int q = 0; q < 4; ++q) {
-      ++visited_;
-      const auto qu = static_cast<std::size_t>(q);
-      // The slot's cells (x, y), x, y in {0, 1}, as bits x + 2 y.
-      const unsigned shift = static_cast<unsigned>((q & 1) * 2 + (q >> 1) * 8);
-      const CellMasks cc{quad(cells.e >> shift), quad(cells.o >> shift)};
-      const CellClass cls = slotClass(cc);
-      if (cls == CellClass::kUnknown) continue;
-      ChildSlot slot(impl_, store_, n, q);
-      if constexpr (kNdt) enterSlot(parts[qu], box);
-      if constexpr (kHits) enterCells(code + (static_cast<std::uint32_t>(q) << 2));
-      delta[qu] = updateSlot(slot, cls, c[qu], [&](Node& m) {
-        ++visited_;
-        impl_.flush(m);
-        return updateCells(m, cc, c[qu], ix0 + (q & 1) * 2, iy0 + (q >> 1) * 2);
-      });
-    }
-    return foldChanges(n, delta);
-  }
-
-  // The exact class of a 4 x 4 square from its cells' classes.
-  static CellClass groupClass(const CellMasks& cc) {
-    if (cc.o != 0) return CellClass::kMixed;
-    if (cc.e == 0xFFFFu) return CellClass::kEmpty;
-    return cc.e == 0 ? CellClass::kUnknown : CellClass::kFreeOrUnknown;
-  }
-
-  // Bits 0, 1, 4, 5 of a 4 x 4 mask (a 2 x 2 corner) as bits 0..3.
-  static std::uint32_t quad(std::uint32_t bits) { return (bits & 3u) | ((bits >> 2) & 0xCu); }
-
-  // The exact class of a 2 x 2 square from its cells' classes.
-  static CellClass slotClass(const CellMasks& cc) {
-    if (cc.o != 0) return CellClass::kMixed;
-    if (cc.e == 0xFu) return CellClass::kEmpty;
-    return cc.e == 0 ? CellClass::kUnknown : CellClass::kFreeOrUnknown;
+  // Applies the policy for `cls` (shifted to the stored values) to the cell stored at *v; returns
+  // the change of its stored value.
+  template <typename T>
+  [[gnu::always_inline]] static double updateCell(T* v, const ShiftedPolicy& sp, CellClass cls) {
+    const double was = static_cast<double>(*v);
+    *v = storedValue<T>(applyShifted<P>(sp, cls, was));
+    return static_cast<double>(*v) - was;
   }
 
   // Eager forgetting (lazy tags off): every detail of the subtree times a, now.
   void scaleSubtree(Node& n) {
     ++visited_;
     for (double& d : n.d) d *= pc_.a;
+    if (WaveletMap::Impl::hasTile(n)) {
+      visited_ += std::uint64_t{1} << (2 * impl_.tile_level);  // its cells
+      impl_.withTile(n, [this](auto& t) { scaleTile(&t, pc_.a); });
+      return;
+    }
     if (n.children == 0) return;
     for (int q = 0; q < 4; ++q) {
       if (impl_.hasChild(n, q)) scaleSubtree(impl_.child(n, q));

@@ -53,8 +53,8 @@ struct SplitTask {
   int level = 0;
   std::int64_t ix0 = 0, iy0 = 0;
   double s = 0.0;
-  std::uint32_t* spare = nullptr;  ///< its spare list (NodePool::pushSpare)
-  std::uint64_t visits = 0;        ///< the nodes its update visited (updateParts)
+  Spares* spare = nullptr;   ///< its spare lists (NodeStore)
+  std::uint64_t visits = 0;  ///< the nodes its update visited (updateParts)
 };
 
 /// The tasks of one scan's split blocks, in the planning's (depth-first) order, and the indices

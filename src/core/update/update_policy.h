@@ -34,6 +34,39 @@ inline double applyPolicy(const PolicyConsts& pc, CellClass cls, double x) {
   return x;
 }
 
+/// applyPolicy() for values held shifted by `shift` (a tile's stored values, storage/tile.h): the
+/// constants moved once per tile instead of every value twice.
+struct ShiftedPolicy {
+  double odd_occ, odd_emp;     ///< the added odd values (max: the compared ones, shifted)
+  double lo, hi;               ///< the clamp bounds, shifted
+  double a, add_occ, add_emp;  ///< forget: a v + add
+};
+template <PolicyType P>
+inline ShiftedPolicy shiftPolicy(const PolicyConsts& pc, double shift) {
+  ShiftedPolicy s;
+  const double odd_shift = P == PolicyType::kMax ? shift : 0.0;
+  s.odd_occ = pc.odd_occ + odd_shift;
+  s.odd_emp = pc.odd_emp + odd_shift;
+  s.lo = pc.lo + shift;
+  s.hi = pc.hi + shift;
+  s.a = pc.a;
+  s.add_occ = pc.g * pc.odd_occ + (1.0 - pc.a) * shift;
+  s.add_emp = pc.g * pc.odd_emp + (1.0 - pc.a) * shift;
+  return s;
+}
+template <PolicyType P>
+inline double applyShifted(const ShiftedPolicy& sp, CellClass cls, double v) {
+  const bool occ = cls == CellClass::kOccupied;
+  const double o = occ ? sp.odd_occ : sp.odd_emp;
+  if constexpr (P == PolicyType::kNone) return v + o;
+  if constexpr (P == PolicyType::kMax) return std::max(v, o);
+  if constexpr (P == PolicyType::kClamp) return std::min(std::max(v + o, sp.lo), sp.hi);
+  if constexpr (P == PolicyType::kForget) return sp.a * v + (occ ? sp.add_occ : sp.add_emp);
+  if constexpr (P == PolicyType::kClampLower) return std::max(v + o, sp.lo);
+  if constexpr (P == PolicyType::kClampUpper) return std::min(v + o, sp.hi);
+  return v;
+}
+
 /// The E update is affine on every cell (so exact on a block average, details untouched or
 /// scaled): none, forget, and clamp_upper (x + odd_emp < x <= hi never reaches the bound).
 template <PolicyType P>
