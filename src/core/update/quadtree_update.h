@@ -16,11 +16,12 @@
 #include <type_traits>
 #include <vector>
 
-#include "update/map_slot.h"
-#include "update/split_plan.h"
+#include "classify/scan_classifier.h"
 #include "payloads/ndt_update.h"
 #include "payloads/reflection_update.h"
-#include "classify/scan_classifier.h"
+#include "update/map_slot.h"
+#include "update/split_plan.h"
+#include "update/tile_update.h"
 #include "update/update_policy.h"
 #include "wavog_mapping/core/haar.h"
 
@@ -319,27 +320,13 @@ class Integrator {
     const double ds = impl_.withTile(n, [&](auto& tile) {
       // A cell's value is s + (v - base): stored value minus `offset`.
       const double offset = tile.base - s;
-      const ShiftedPolicy sp = shiftPolicy<P>(pc_, offset);
-      double sum = 0.0;
-      std::uint64_t e = cells.e;
-      for (unsigned row = 0; row < 64; row += 8) {
-        // A row all E (most rows of the cleared space) without a bit scan.
-        if (((e >> row) & 0xFFu) != 0xFFu) continue;
-        for (unsigned x = 0; x < 8; ++x) {
-          sum += updateCell(&tile.v[row + x], sp, CellClass::kEmpty);
-        }
-        e &= ~(std::uint64_t{0xFF} << row);
-      }
-      for (std::uint64_t m = e; m != 0; m &= m - 1) {
-        sum += updateCell(&tile.v[__builtin_ctzll(m)], sp, CellClass::kEmpty);
-      }
-      for (std::uint64_t m = cells.o; m != 0; m &= m - 1) {
-        const auto i = static_cast<unsigned>(__builtin_ctzll(m));
-        if constexpr (kHits) {
+      if constexpr (kHits) {
+        for (std::uint64_t m = cells.o; m != 0; m &= m - 1) {
+          const auto i = static_cast<unsigned>(__builtin_ctzll(m));
           observed_->push_back({slot_code_ + kTileMorton.code[i], tile.v[i] - offset});
         }
-        sum += updateCell(&tile.v[i], sp, CellClass::kOccupied);
       }
+      const double sum = updateTileCells<P>(shiftPolicy<P>(pc_, offset), &tile, cells.e, cells.o);
       tile.known |= observed;
       // The cells' mean moved by the change: so does base, and the unobserved cells keep their
       // stored values.
@@ -349,15 +336,6 @@ class Integrator {
     });
     impl_.dropTileIfUniform(store_, n);
     return ds;
-  }
-
-  // Applies the policy for `cls` (shifted to the stored values) to the cell stored at *v; returns
-  // the change of its stored value.
-  template <typename T>
-  [[gnu::always_inline]] static double updateCell(T* v, const ShiftedPolicy& sp, CellClass cls) {
-    const double was = static_cast<double>(*v);
-    *v = storedValue<T>(applyShifted<P>(sp, cls, was));
-    return static_cast<double>(*v) - was;
   }
 
   // Eager forgetting (lazy tags off): every detail of the subtree times a, now.
