@@ -1,7 +1,8 @@
-// Quadtree nodes and the pool that stores them: a node holds the three Haar details of its 2x2
+// Quadtree nodes and the pools that store them: a node holds the three Haar details of its 2x2
 // children, its lazy forgetting count and what is known of its children; groups of four child
-// nodes live in a pool of fixed chunks (addresses never move). Part of WaveletMap's private
-// storage; not installed, included only by src/core/* and the core tests.
+// nodes, and the tiles of the tile nodes (tile.h), live in pools of fixed chunks (addresses never
+// move). Part of WaveletMap's private storage; not installed, included only by src/core/* and the
+// core tests.
 #ifndef WAVOG_MAPPING_SRC_CORE_STORAGE_NODE_POOL_H_
 #define WAVOG_MAPPING_SRC_CORE_STORAGE_NODE_POOL_H_
 
@@ -21,12 +22,13 @@
 namespace wavog {
 namespace detail {
 
-/// One quadtree node at level l >= 1: the three Haar details of its 2x2 children, its children
-/// (a group of 4 node slots in the pool; a missing child is a uniform block), the pending lazy
-/// forgetting (k units, see WaveletMap::Impl::multiplier) and what is known of its children.
-/// Level-1 nodes have finest cells as children. A trivial type: `Node{}` is the empty node (all
-/// zero); `Node n;` is uninitialised, so that the pool's chunks need not be cleared (allocate()
-/// clears each group it hands out).
+/// One quadtree node at a level at or above the tile level (storage/tile.h): the three Haar
+/// details of its 2x2 children, its children (a group of 4 node slots in the pool; a missing child
+/// is a uniform block), the pending lazy forgetting (k units, see WaveletMap::Impl::multiplier)
+/// and what is known of its children. A node of the tile level has no details and no child nodes:
+/// `children` is the index of its tile (child_mask kTileBit). A trivial type: `Node{}` is the
+/// empty node (all zero); `Node n;` is uninitialised, so that the pool's chunks need not be
+/// cleared (allocate() clears each group it hands out).
 struct Node {
   /// Stored details dx, dy, dxy (true = stored * multiplier(k's)). Double: a cell is its block's
   /// average plus its ancestors' details, so beside a cell of log-odds L the float details could
