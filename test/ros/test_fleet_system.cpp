@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -221,9 +222,11 @@ TEST(Fleet, ThreeVehiclesOneMap) {
   if (v3 > 0) ASSERT_TRUE(flush("/v3/wavog_mapping/flush"));
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(120.0);
   std::vector<std::size_t> counts;
+  std::string last_state = "no fleet status";  // the last poll's, for a failure's message
   for (int settled = 0; settled < 4;) {
     ASSERT_LT(ros::WallTime::now(), give_up) << "the fleet node never received and integrated "
-                                                "every streamed scan";
+                                                "every streamed scan; last poll: "
+                                             << last_state;
     ros::WallDuration(1.0).sleep();
     ASSERT_TRUE(flush("/wavog_fleet/flush"));  // publishes ~fleet_status
     ros::WallDuration(0.2).sleep();
@@ -231,10 +234,16 @@ TEST(Fleet, ThreeVehiclesOneMap) {
     bool done =
         rec.status && rec.status->buffered == 0 && rec.status->vehicles.size() == kVehicles.size();
     std::vector<std::size_t> now_counts;
+    std::ostringstream state;
+    if (rec.status) state << "buffered " << rec.status->buffered;
     for (std::size_t k = 0; k < kVehicles.size(); ++k) {
       now_counts.push_back(rec.scans[k].size());
-      done = done && rec.status->vehicles[k].received == rec.scans[k].size();
+      const bool known = rec.status && k < rec.status->vehicles.size();
+      done = done && known && rec.status->vehicles[k].received == rec.scans[k].size();
+      state << "; " << kVehicles[k] << " recorded " << rec.scans[k].size() << ", fleet received "
+            << (known ? std::to_string(rec.status->vehicles[k].received) : std::string("-"));
     }
+    last_state = state.str();
     settled = done && now_counts == counts ? settled + 1 : 0;
     counts = now_counts;
   }
