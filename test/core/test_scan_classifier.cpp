@@ -90,27 +90,26 @@ class Walk {
   void expectTile(std::int64_t ix0, std::int64_t iy0, const SquareInfo& info) {
     if (ScanClassifier::fewSectors(info)) ++seen_->groups_8x8;
     const TileMasks m = cls_.classifyTileCells(3, ix0, iy0, info);
-    for (unsigned i = 0; i < 64; ++i) {
-      const std::int64_t x = ix0 + (i & 7), y = iy0 + (i >> 3);
-      const CellClass want = ref_.cellClass(x, y);
-      const CellClass got = ((m.e >> i) & 1u)   ? CellClass::kEmpty
-                            : ((m.o >> i) & 1u) ? CellClass::kOccupied
-                                                : CellClass::kUnknown;
-      ASSERT_FALSE(((m.e >> i) & 1u) && ((m.o >> i) & 1u)) << "cell both E and O";
-      ASSERT_EQ(got, want) << "tile at (" << ix0 << ", " << iy0 << "), cell (" << x << ", " << y
-                           << ")";
-    }
+    expectCells("tile", ix0, iy0, 3, m.e, m.o);
   }
 
   void expectGroup(std::int64_t ix0, std::int64_t iy0, const CellMasks& m) {
-    for (unsigned i = 0; i < 16; ++i) {
-      const std::int64_t x = ix0 + (i & 3), y = iy0 + (i >> 2);
+    expectCells("4x4", ix0, iy0, 2, m.e, m.o);
+  }
+
+  // The cells of the square of side 2^bits at (ix0, iy0), cell (x, y) at bit x + 2^bits y of the
+  // masks e (E) and o (O), against the reference.
+  void expectCells(const char* what, std::int64_t ix0, std::int64_t iy0, unsigned bits,
+                   std::uint64_t e, std::uint64_t o) {
+    const unsigned side = 1u << bits;
+    for (unsigned i = 0; i < side * side; ++i) {
+      const std::int64_t x = ix0 + (i & (side - 1)), y = iy0 + (i >> bits);
       const CellClass want = ref_.cellClass(x, y);
-      const CellClass got = ((m.e >> i) & 1u)   ? CellClass::kEmpty
-                            : ((m.o >> i) & 1u) ? CellClass::kOccupied
-                                                : CellClass::kUnknown;
-      ASSERT_FALSE(((m.e >> i) & 1u) && ((m.o >> i) & 1u)) << "cell both E and O";
-      ASSERT_EQ(got, want) << "4x4 at (" << ix0 << ", " << iy0 << "), cell (" << x << ", " << y
+      const CellClass got = ((e >> i) & 1u)   ? CellClass::kEmpty
+                            : ((o >> i) & 1u) ? CellClass::kOccupied
+                                              : CellClass::kUnknown;
+      ASSERT_FALSE(((e >> i) & 1u) && ((o >> i) & 1u)) << "cell both E and O";
+      ASSERT_EQ(got, want) << what << " at (" << ix0 << ", " << iy0 << "), cell (" << x << ", " << y
                            << ")";
     }
   }

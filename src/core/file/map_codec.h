@@ -1,13 +1,14 @@
 // The byte codec of native map files (map_io.cpp, the layout there): a writer and a bounds-checked
-// reader of little-endian values, and the payload sections map_payload_io.cpp reads and writes
-// (the blocks' normal-distribution cells and the reflection map's hits). Not installed; included
-// only by src/core/file/map_io.cpp and map_payload_io.cpp.
+// reader of little-endian values, the payload sections map_payload_io.cpp reads and writes (the
+// blocks' normal-distribution cells and the reflection map's hits) and the tiles of
+// map_tile_io.cpp. Not installed; included only by src/core/file/*.cpp.
 #ifndef WAVOG_MAPPING_SRC_CORE_FILE_MAP_CODEC_H_
 #define WAVOG_MAPPING_SRC_CORE_FILE_MAP_CODEC_H_
 
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "storage/map_impl.h"
@@ -73,6 +74,16 @@ struct FileReflection {
 void writeReflection(const WaveletMap::Impl& impl, Writer* w);
 FileReflection readReflection(WaveletMap::Impl& fresh, bool keep, std::uint32_t version,
                               std::size_t bytes, Reader* r);
+
+/// The refusal of a log-odds the update cannot carry (limits.h, kMaxStoredLogOdds).
+std::string beyondBound(const char* what, double value);
+
+/// A tile node's tile (version 7; map_tile_io.cpp): written after its node; read into node n of
+/// a fresh map (its flags read and checked). Throw std::runtime_error on inconsistent data.
+void writeTile(const WaveletMap::Impl& impl, const Node& n, Writer* w);
+void readTile(WaveletMap::Impl& impl, Node& n, Reader* r);
+/// Node n of the tile level, read as a Haar node with its subtree, made a tile node.
+void makeTile(WaveletMap::Impl& impl, Node& n);
 
 }  // namespace detail
 }  // namespace wavog

@@ -27,7 +27,7 @@
 // all load. Stored details and lazy counts are written as they are, so a round trip is bit-exact; a
 // map loaded under another factor applies the file's pending tags while loading. Files are written
 // and read through map_file.h (exclusive temporary + rename, regular files only); the payload
-// sections (Gaussians, hits) are map_payload_io.cpp's.
+// sections (Gaussians, hits) are map_payload_io.cpp's, the tiles map_tile_io.cpp's.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -48,7 +48,19 @@
 #include "wavog_mapping/core/wavelet_map.h"
 
 namespace wavog {
+
+namespace detail {
+std::string beyondBound(const char* what, double value) {
+  std::ostringstream s;
+  s << what << " of " << value << " log-odds, beyond the +-" << kMaxStoredLogOdds
+    << " an update keeps finite";
+  return s.str();
+}
+}  // namespace detail
+
 namespace {
+
+using detail::beyondBound;
 
 using detail::Block;
 using detail::Node;
@@ -89,27 +101,13 @@ void writeNode(const WaveletMap::Impl& impl, const Node& n, int l, Writer* w) {
   w->put(static_cast<std::uint8_t>(n.known_all));
   w->put(static_cast<std::uint8_t>(n.known_any));
   if (WaveletMap::Impl::hasTile(n)) {
-    impl.withTile(n, [&](const auto& t) {
-      w->put(t.known);
-      w->put(t.base);
-      for (std::uint64_t m = detail::tileCells(impl.tile_level); m != 0; m &= m - 1) {
-        w->put(static_cast<double>(t.v[__builtin_ctzll(m)]));
-      }
-    });
+    detail::writeTile(impl, n, w);
     return;
   }
   if (l <= 1) return;
   for (int q = 0; q < 4; ++q) {
     if (impl.hasChild(n, q)) writeNode(impl, impl.child(n, q), l - 1, w);
   }
-}
-
-// The refusal of a log-odds the update cannot carry (limits.h, kMaxStoredLogOdds).
-std::string beyondBound(const char* what, double value) {
-  std::ostringstream s;
-  s << what << " of " << value << " log-odds, beyond the +-" << kMaxStoredLogOdds
-    << " an update keeps finite";
-  return s.str();
 }
 
 // How a file's pending counts are read: their width and the factor one unit stands for.
@@ -131,83 +129,6 @@ void checkSlotKnowledge(bool slot_all, bool slot_any, unsigned known_all, unsign
 }
 void checkUniformKnowledge(bool all, bool any) {
   if (all != any) throw std::runtime_error("a uniform slot partly observed");
-}
-
-// Stores `cells` as the tile of node n (a fresh map's), float or wide as the map keeps them.
-void storeTile(WaveletMap::Impl& impl, Node& n, const detail::WideTile& cells) {
-  detail::NodeStore store = impl.serialStore();
-  impl.addTile(store, n);
-  impl.withTile(n, [&](auto& t) {
-    using T = std::remove_reference_t<decltype(t.v[0])>;
-    for (std::size_t i = 0; i < 64; ++i) t.v[i] = detail::storedValue<T>(cells.v[i]);
-    t.known = cells.known;
-    t.base = cells.base;
-  });
-}
-
-// Reads the tile of node n (a fresh map's; its flags read and checked).
-void readTile(WaveletMap::Impl& impl, Node& n, Reader* r) {
-  detail::WideTile t;
-  detail::fillTile(&t, impl.tile_level, false);
-  const std::uint64_t cells = detail::tileCells(impl.tile_level);
-  t.known = r->get<std::uint64_t>();
-  t.base = r->get<double>();
-  if ((t.known & ~cells) != 0) throw std::runtime_error("bad tile cells");
-  if (!std::isfinite(t.base) || std::fabs(t.base) > kMaxStoredLogOdds) {
-    throw std::runtime_error("bad tile base");
-  }
-  for (std::uint64_t m = cells; m != 0; m &= m - 1) {
-    const auto v = r->get<double>();
-    // A cell's value is its node's average plus v - base, each within the bound.
-    if (!std::isfinite(v) || std::fabs(v) > kMaxStoredLogOdds) {
-      throw std::runtime_error(beyondBound("a tile cell", v));
-    }
-    t.v[__builtin_ctzll(m)] = v;
-  }
-  const detail::TileKnowledge k = detail::tileKnowledge(impl.tile_level, t.known);
-  if (k.all != n.known_all || k.any != n.known_any) {
-    throw std::runtime_error("a tile's cells disagree with its node's knowledge");
-  }
-  for (double d : n.d) {
-    if (d != 0.0) throw std::runtime_error("a tile node with details");
-  }
-  storeTile(impl, n, t);
-}
-
-// The cells below node n (level l, first cell (x0, y0) of its tile, average avg, pending
-// multiplier of its details mult) into tile t, with their knowledge.
-void tileCellsOf(const WaveletMap::Impl& impl, const Node& n, int l, unsigned x0, unsigned y0,
-                 double avg, double mult, detail::WideTile* t) {
-  const double d[3] = {n.d[0] * mult, n.d[1] * mult, n.d[2] * mult};
-  const auto c = haar::backward(avg, d);
-  const unsigned half = 1u << (l - 1);
-  for (int q = 0; q < 4; ++q) {
-    const unsigned x = x0 + ((q & 1) ? half : 0), y = y0 + ((q & 2) ? half : 0);
-    const double cq = c[static_cast<std::size_t>(q)];
-    if (l > 1 && impl.hasChild(n, q)) {
-      const Node& ch = impl.child(n, q);
-      tileCellsOf(impl, ch, l - 1, x, y, cq, mult * impl.multiplier(ch.k), t);
-      continue;
-    }
-    const std::uint64_t cells = detail::tileSquare(l - 1, x, y);
-    for (std::uint64_t m = cells; m != 0; m &= m - 1) {
-      t->v[__builtin_ctzll(m)] = cq;
-    }
-    if ((n.known_all >> q) & 1u) t->known |= cells;
-  }
-}
-
-// A node of the tile level read as a Haar node (every file before version 7; a version-7 file
-// may hold one too): n and its subtree become a tile node,
-// its cells at base 0 (their value minus the node's average); n keeps its pending count.
-void makeTile(WaveletMap::Impl& impl, Node& n) {
-  detail::WideTile cells;
-  detail::fillTile(&cells, impl.tile_level, false);
-  tileCellsOf(impl, n, impl.tile_level, 0, 0, 0.0, 1.0, &cells);
-  detail::NodeStore store = impl.serialStore();
-  impl.freeSubtree(store, n);
-  n.d[0] = n.d[1] = n.d[2] = 0.0;
-  storeTile(impl, n, cells);
 }
 
 // Reads a subtree into `impl` (a fresh map); `slot_all` / `slot_any`: the knowledge its slot
@@ -246,7 +167,7 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
   checkSlotKnowledge(slot_all, slot_any, known_all, known_any);
   if (tile) {
     if (l != impl.tile_level) throw std::runtime_error("a tile off the tile level");
-    readTile(impl, n, r);
+    detail::readTile(impl, n, r);
     if (applied != 1.0) impl.withTile(n, [&](auto& t) { detail::scaleTile(&t, applied); });
     return;
   }
@@ -259,7 +180,7 @@ void readNode(WaveletMap::Impl& impl, Node& n, int l, const PendingFormat& f, st
     Node& c = impl.installChild(n, q, Node{});
     readNode(impl, c, l - 1, f, pending, all, any, r);
   }
-  if (l == impl.tile_level) makeTile(impl, n);
+  if (l == impl.tile_level) detail::makeTile(impl, n);
 }
 
 // Opens `path` (a regular file only) and reads it whole, once its header says it is a map of this
