@@ -10,6 +10,7 @@
 #include <chrono>
 #include <utility>
 
+#include "fleet/fleet_stream.h"
 #include "mapping_ros_impl.h"
 
 namespace wavog_ros {
@@ -54,19 +55,22 @@ std::size_t MappingRos::Impl::flushPending() {
     for (auto& in : inputs_) in->filter->clear();
   }
   std::vector<std::pair<Input*, PendingScan>> waiting;
+  std::size_t released = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto& in : inputs_) {
+      // First those tf covers by now (the retry timer's work, done at once).
+      released += releaseReadyLocked(in.get());
       for (auto& p : in->pending) waiting.emplace_back(in.get(), std::move(p));
       in->pending.clear();
       in->outside = 0;
     }
   }
-  // No newer tf is coming: the scan is placed by the newest transform of its frame, without
-  // motion compensation (there is no tf over its sweep). The scans tf placed already, waiting
-  // for one received before them, keep their placement; all in the order received.
-  PlacementOptions options = placement_;
-  options.motion_compensation = false;
+  if (released > 0 && fleet_stream_) fleet_stream_->publishQueued();  // without the lock
+  // No newer tf is coming: a scan tf covers is placed at its stamp, as wavog_offline places it
+  // (motion-compensated if tf covers its sweep); one beyond the newest transform of its frame is
+  // placed by that transform, uncompensated. The scans tf placed already, waiting for one received
+  // before them, keep their placement; all in the order received.
   std::size_t flushed = 0;
   for (auto& w : waiting) {
     Input* in = w.first;
@@ -76,11 +80,15 @@ std::size_t MappingRos::Impl::flushPending() {
       continue;
     }
     auto scan = boost::make_shared<sensor_msgs::LaserScan>(*w.second.scan);
+    PlacementOptions options = placement_;
     std::string error;
     try {
       const auto t =
           buffer_->lookupTransform(placement_.fixed_frame, scan->header.frame_id, ros::Time(0));
-      if (t.header.stamp < scan->header.stamp) scan->header.stamp = t.header.stamp;
+      if (t.header.stamp < scan->header.stamp) {
+        scan->header.stamp = t.header.stamp;
+        options.motion_compensation = false;
+      }
     } catch (const tf2::TransformException& e) {
       error = e.what();
     }
@@ -98,6 +106,7 @@ std::size_t MappingRos::Impl::flushPending() {
     integrateLocked(in, *scan, placement);
     if (in->c[Counter::kIntegrated] > before) {
       ++in->c[Counter::kIntegratedLatestTf];
+      in->c[Counter::kMotionFallbacks] += placement.motion_fallback ? 1 : 0;
       ++flushed;
     }
   }

@@ -73,8 +73,10 @@ struct PendingScan {
   sensor_msgs::LaserScan::ConstPtr scan;
   bool placed = false;  ///< out of the filter: `placement` holds what tf said (or its failure)
   ScanPlacement placement;  ///< valid when `placed`
-  /// Pushed out of the full tf filter (more than queue_size scans waiting for tf): waits here,
-  /// placed by releaseReadyLocked once tf covers its stamp (Input::outside counts these).
+  /// Waits here for tf, outside the filter: pushed out of the full filter (more than queue_size
+  /// scans waiting for tf), or passed by it before tf covered its sweep's end (motion
+  /// compensation). Placed by releaseReadyLocked once tf covers its stamp + tf_tolerance and its
+  /// sweep's end (Input::outside counts these).
   bool outside = false;
 };
 

@@ -252,8 +252,16 @@ void MappingRos::Impl::onTransformable(Input* in, const sensor_msgs::LaserScan::
     std::lock_guard<std::mutex> lock(mutex_);
     PendingScan* p = findPendingLocked(in, scan.get());
     if (p == nullptr) return;  // flushed meanwhile (flushPending)
-    p->placed = true;
-    p->placement = placement;
+    if (placement.end_missing) {
+      // tf reached the stamp + tf_tolerance, not yet the sweep's end: whether it had would
+      // depend on how busy the host is, so the scan waits here for it as the scans pushed out
+      // of the filter do (releaseReadyLocked, the retry timer, flushPending).
+      p->outside = true;
+      ++in->outside;
+    } else {
+      p->placed = true;
+      p->placement = placement;
+    }
     releaseReadyLocked(in);
   }
   if (fleet_stream_) fleet_stream_->publishQueued();  // without the lock
@@ -270,10 +278,17 @@ std::size_t MappingRos::Impl::releaseReadyLocked(Input* in) {
   auto& p = in->pending;
   std::size_t n = 0;
   const ros::Duration tolerance(config_.ros.tf_tolerance);
-  const auto transformable = [&](const PendingScan& s) {
+  const auto covered = [&](const PendingScan& s) {
     const std_msgs::Header& h = s.scan->header;
     return buffer_->canTransform(placement_.fixed_frame, h.frame_id, h.stamp) &&
            buffer_->canTransform(placement_.fixed_frame, h.frame_id, h.stamp + tolerance);
+  };
+  // ... and the sweep's end, when its motion is compensated.
+  const auto transformable = [&](const PendingScan& s) {
+    ros::Time end;
+    return covered(s) &&
+           (!sweepEndStamp(*s.scan, placement_, &end) ||
+            buffer_->canTransform(placement_.fixed_frame, s.scan->header.frame_id, end));
   };
   // A scan tf cannot place while more than queue_size scans behind it are placed (tf for its
   // frame alone missing; the filter, holding only it, never overflows) no longer holds them up.
@@ -291,16 +306,18 @@ std::size_t MappingRos::Impl::releaseReadyLocked(Input* in) {
       continue;
     }
     if (front.outside) {
-      // Placed here as the filter would have placed it: tf covers its stamp + tf_tolerance.
-      if (transformable(front)) {
+      // Placed here as the filter would have placed it (tf covers its stamp + tf_tolerance and
+      // the sweep's end), or at a bound with only the sweep's end missing (uncompensated).
+      DropReason reason{};
+      std::string why;
+      if (transformable(front) ||
+          (!(why = outsideDropLocked(in, &reason)).empty() && covered(front))) {
         front.placement = placeScan(*buffer_, *front.scan, placement_);
         front.placed = true;
         front.outside = false;
         --in->outside;
         continue;
       }
-      DropReason reason{};
-      const std::string why = outsideDropLocked(in, &reason);
       if (why.empty()) break;
       p.pop_front();
       --in->outside;
@@ -389,8 +406,7 @@ void MappingRos::Impl::integratePlacedScanLocked(Input* in, const sensor_msgs::L
   }
   if (placement.motion_fallback) {
     ++in->c[Counter::kMotionFallbacks];
-    warnLocked(in, kOtherWarning,
-               motionFallbackText(config_.ros.tf_tolerance, sweepSeconds(scan)));
+    warnLocked(in, kOtherWarning, motionFallbackText(config_.ros.queue_size, sweepSeconds(scan)));
   }
   integrateLocked(in, scan, placement);
 }

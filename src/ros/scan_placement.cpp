@@ -10,6 +10,26 @@
 
 namespace wavog_ros {
 
+namespace {
+
+/// The options compensate the scan's motion, and the scan times its beams.
+bool wantsCompensation(const sensor_msgs::LaserScan& scan, const PlacementOptions& options) {
+  return options.motion_compensation && scan.header.frame_id != options.fixed_frame &&
+         scan.ranges.size() >= 2 && std::isfinite(scan.time_increment) &&
+         scan.time_increment != 0.0f;
+}
+
+}  // namespace
+
+bool sweepEndStamp(const sensor_msgs::LaserScan& scan, const PlacementOptions& options,
+                   ros::Time* end) {
+  if (!wantsCompensation(scan, options)) return false;
+  // checkScanTime() refuses the sweeps ROS time cannot represent; here they only skip the
+  // compensation, so that placeScan() never throws.
+  return std::abs(sweepSeconds(scan)) <= kMaxSweepSeconds &&
+         addSeconds(scan.header.stamp, sweepSeconds(scan), end);
+}
+
 ScanPlacement placeScan(const tf2::BufferCore& tf, const sensor_msgs::LaserScan& scan,
                         const PlacementOptions& options) {
   ScanPlacement p;
@@ -30,17 +50,9 @@ ScanPlacement placeScan(const tf2::BufferCore& tf, const sensor_msgs::LaserScan&
     return p;
   }
   p.end = p.start;
-
-  const std::size_t n = scan.ranges.size();
-  if (!options.motion_compensation || n < 2 || !std::isfinite(scan.time_increment) ||
-      scan.time_increment == 0.0f) {
-    return p;
-  }
-  // checkScanTime() refuses the sweeps ROS time cannot represent; here they only skip the
-  // compensation, so that this function never throws.
+  if (!wantsCompensation(scan, options)) return p;
   ros::Time end_stamp;
-  if (!(std::abs(sweepSeconds(scan)) <= kMaxSweepSeconds) ||
-      !addSeconds(scan.header.stamp, sweepSeconds(scan), &end_stamp)) {
+  if (!sweepEndStamp(scan, options, &end_stamp)) {
     p.motion_fallback = true;
     return p;
   }
@@ -52,6 +64,7 @@ ScanPlacement placeScan(const tf2::BufferCore& tf, const sensor_msgs::LaserScan&
   } catch (const std::exception&) {
     p.end = p.start;
     p.motion_fallback = true;
+    p.end_missing = true;
   }
   return p;
 }

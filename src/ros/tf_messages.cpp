@@ -47,14 +47,13 @@ std::string noTransformText(const tf2::BufferCore& tf, const std::string& scan_f
          std::to_string(queue_size) + " scans waiting for tf)";
 }
 
-std::string motionFallbackText(double tolerance, double sweep) {
+std::string motionFallbackText(int queue_size, double sweep) {
   std::ostringstream s;
-  s << "no tf at the end of the sweep (" << sweep << " s after the scan's stamp) when tf reached "
-    << "the stamp + tf_tolerance (" << tolerance << " s): motion compensation skipped";
-  if (tolerance < sweep) {
-    s << "; set tf_tolerance to the sweep's " << std::min(sweep, 1.0)
-      << " s (at most 1) to wait for it, or motion_compensation: false";
-  }
+  s << "tf did not reach the end of the sweep (" << sweep << " s after the scan's stamp) while "
+    << "the scan waited for it (more than queue_size " << queue_size
+    << " later scans placed, or the wait's bounds): placed without motion compensation. tf "
+       "stopping short of every sweep means a wrong time_increment, or set motion_compensation: "
+       "false";
   return s.str();
 }
 

@@ -22,9 +22,10 @@ std::string framesOf(const tf2::BufferCore& tf, std::size_t max_listed = 12);
 std::string noTransformText(const tf2::BufferCore& tf, const std::string& scan_frame,
                             const std::string& fixed_frame, int queue_size);
 
-/// A scan placed without motion compensation because tf did not reach the end of its sweep:
-/// names tf_tolerance (`tolerance`, s) against the sweep (`sweep`, s).
-std::string motionFallbackText(double tolerance, double sweep);
+/// A scan placed without motion compensation because tf did not reach the end of its sweep
+/// (`sweep`, s) while it waited at most as the scans waiting for tf do (`queue_size`: the
+/// filter's).
+std::string motionFallbackText(int queue_size, double sweep);
 
 }  // namespace wavog_ros
 

@@ -115,7 +115,11 @@ TEST(ScanPlacement, NoTfAtTheLastBeamPlacesTheScanUncompensated) {
   const wavog_ros::ScanPlacement p = wavog_ros::placeScan(tf, scan, wavog_ros::PlacementOptions{});
   ASSERT_TRUE(p.placed()) << p.error;
   EXPECT_TRUE(p.motion_fallback);
+  EXPECT_TRUE(p.end_missing);  // the node waits for this tf
   EXPECT_FALSE(p.compensate);
+  ros::Time end;
+  ASSERT_TRUE(wavog_ros::sweepEndStamp(scan, wavog_ros::PlacementOptions{}, &end));
+  EXPECT_NEAR(end.toSec() - scan.header.stamp.toSec(), kSweep, 1e-6);
   wavog::MotionCompensator compensator;
   wavog::Pose2 pose;
   const wavog::ScanView view = p.placedView(scan, &compensator, &pose);
@@ -136,6 +140,9 @@ TEST(ScanPlacement, CompensationOffOrUntimedBeamsUseTheStampOnly) {
     ASSERT_TRUE(p.placed()) << p.error;
     EXPECT_FALSE(p.compensate);
     EXPECT_FALSE(p.motion_fallback);
+    EXPECT_FALSE(p.end_missing);
+    ros::Time end;
+    EXPECT_FALSE(wavog_ros::sweepEndStamp(scan, options, &end));  // nothing to wait for
     EXPECT_NEAR(p.start.x, kMount + kSpeed * 0.5, 1e-9);
     EXPECT_EQ(p.end.x, p.start.x);
   }
@@ -169,13 +176,12 @@ TEST(TfMessages, NameTheMissingFrameAndTheFramesTfHas) {
   EXPECT_EQ(wavog_ros::framesOf(apart, 2), "base_link, laser and 2 more");
 }
 
-TEST(TfMessages, ASkippedCompensationNamesTfToleranceAndTheSweep) {
-  const std::string text = wavog_ros::motionFallbackText(0.03, 0.99);
+TEST(TfMessages, ASkippedCompensationNamesTheSweepAndTheBound) {
+  const std::string text = wavog_ros::motionFallbackText(10, 0.99);
   EXPECT_NE(text.find("0.99 s after the scan's stamp"), std::string::npos) << text;
-  EXPECT_NE(text.find("tf_tolerance (0.03 s)"), std::string::npos) << text;
-  EXPECT_NE(text.find("set tf_tolerance to the sweep's 0.99 s"), std::string::npos) << text;
-  // A tolerance that covers the sweep: tf was late, no advice to raise it.
-  EXPECT_EQ(wavog_ros::motionFallbackText(0.5, 0.1).find("set tf_tolerance"), std::string::npos);
+  EXPECT_NE(text.find("queue_size 10"), std::string::npos) << text;
+  EXPECT_NE(text.find("time_increment"), std::string::npos) << text;
+  EXPECT_NE(text.find("motion_compensation: false"), std::string::npos) << text;
 }
 
 }  // namespace

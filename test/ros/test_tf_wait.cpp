@@ -3,6 +3,8 @@
 // the fix they were dropped as tf_unavailable, so a bag's map depended on how late tf came), and be
 // dropped only at the bounds: more than subscriber_queue_size (50) waiting (tf stopped), or the
 // newest transform of their frame more than tf_cache_time (10 s) after their stamp (tf_too_old).
+// A scan whose stamp + tf_tolerance tf covers, but not its sweep's end, waits for that tf too:
+// placed as soon as tf reached the stamp, it was compensated or not by how busy the host was.
 // Each case on its own input, so that the scans one holds back do not hold up another's.
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
@@ -51,7 +53,7 @@ wavog_mapping::MapperStatus::ConstPtr waitInput(std::size_t i, Pred pred, double
   return room::waitLatest(
       &g_mutex, &g_status,
       [&](const wavog_mapping::MapperStatus& s) {
-        return s.inputs.size() == 3 && pred(s.inputs[i]);
+        return s.inputs.size() == 4 && pred(s.inputs[i]);
       },
       timeout);
 }
@@ -75,7 +77,7 @@ TEST(TfWait, PushedOutScansWaitForTfAndStopAtTheBounds) {
             g_status = m;
           }));
   std::vector<ros::Publisher> pubs;
-  for (const char* topic : {"scan_late", "scan_stopped", "scan_old"}) {
+  for (const char* topic : {"scan_late", "scan_stopped", "scan_old", "scan_sweep"}) {
     pubs.push_back(nh.advertise<sensor_msgs::LaserScan>(topic, 100));
   }
   tf2_ros::TransformBroadcaster tf;
@@ -101,10 +103,18 @@ TEST(TfWait, PushedOutScansWaitForTfAndStopAtTheBounds) {
   // tf can never place them.
   tf.sendTransform(mapTo("old", t0 - ros::Duration(5.0)));
   publishScans(pubs[2], "old", t0, 4);
+  // Sweep: tf up to 0.05 s after the stamp (tf_tolerance 0.03 s), then, after the scan has
+  // passed the filter, beyond the sweep's 0.2 s.
+  tf.sendTransform(std::vector<geometry_msgs::TransformStamped>{
+      mapTo("sweep", t0 - ros::Duration(1.0)), mapTo("sweep", t0 + ros::Duration(0.05))});
+  ros::WallDuration(0.2).sleep();
+  auto sweep = scanAt("sweep", t0);
+  sweep->time_increment = static_cast<float>(0.2 / 199);
+  pubs[3].publish(sweep);
   ros::WallDuration(0.5).sleep();
   tf.sendTransform(std::vector<geometry_msgs::TransformStamped>{
       mapTo("late", t0 - ros::Duration(1.0)), mapTo("late", t0 + ros::Duration(3.0)),
-      mapTo("old", t0 + ros::Duration(100.0))});
+      mapTo("old", t0 + ros::Duration(100.0)), mapTo("sweep", t0 + ros::Duration(3.0))});
 
   const auto late = waitInput(
       0, [](const wavog_mapping::InputStatus& in) { return in.integrated >= 10; }, 20.0);
@@ -112,6 +122,11 @@ TEST(TfWait, PushedOutScansWaitForTfAndStopAtTheBounds) {
   EXPECT_EQ(late->inputs[0].received, 10u);
   EXPECT_EQ(late->inputs[0].integrated, 10u) << late->inputs[0];
   EXPECT_EQ(late->inputs[0].dropped_tf_unavailable, 0u) << late->inputs[0];
+
+  const auto swept = waitInput(
+      3, [](const wavog_mapping::InputStatus& in) { return in.integrated >= 1; }, 20.0);
+  ASSERT_TRUE(swept);
+  EXPECT_EQ(swept->inputs[3].motion_fallbacks, 0u) << swept->inputs[3];
 
   const auto stopped = waitInput(
       1, [](const wavog_mapping::InputStatus& in) { return in.dropped_tf_unavailable >= 4; }, 20.0);

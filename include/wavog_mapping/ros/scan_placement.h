@@ -44,6 +44,9 @@ struct ScanPlacement {
   bool mirrored = false;  ///< the laser's z axis points down: its bearings are mirrored
   bool compensate = false;       ///< start and end both known: the sweep is re-binned
   bool motion_fallback = false;  ///< compensation wanted, but no tf at the last beam
+  /// Of motion_fallback: the sweep is valid but tf did not cover its last beam (yet). A live
+  /// node waits for that tf (it may still come); an invalid sweep never waits.
+  bool end_missing = false;
 
   bool placed() const { return failure == TfFailure::kNone; }
 
@@ -53,6 +56,12 @@ struct ScanPlacement {
   wavog::ScanView placedView(const sensor_msgs::LaserScan& scan,
                              wavog::MotionCompensator* compensator, wavog::Pose2* pose) const;
 };
+
+/// The stamp of the last beam of a scan that passed checkScan(), when `options` compensate its
+/// motion: false when they do not (compensation off, fewer than 2 beams, no time_increment, the
+/// scan in the fixed frame) or its sweep is not representable.
+bool sweepEndStamp(const sensor_msgs::LaserScan& scan, const PlacementOptions& options,
+                   ros::Time* end);
 
 /// Looks up the sensor pose of a scan that passed checkScan() (conversions.h) in `tf`, at its
 /// first beam and, with motion compensation, at its last. Never throws: a failed first lookup
