@@ -8,7 +8,7 @@
 // and YAML (the same thresholds, the same aggregation): every cell occupied there is occupied to
 // both rules, at least kMinFreeShare of its free cells free; a layer subscribed to only after the
 // bag's clock has stopped arrives, as do /diagnostics; ~reset publishes the reset map (same box,
-// every cell unknown) within kResetSeconds of wall time. Per layer, the known cells each rule
+// every cell unknown) while the clock is stopped. Per layer, the known cells each rule
 // reads as occupied / free / unknown are printed (the figures of issue 41).
 //
 // Private parameters: bag, config (the YAML both use), scales (the node's publish_scales).
@@ -23,12 +23,15 @@
 #include <std_srvs/Trigger.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <vector>
@@ -44,8 +47,9 @@ namespace fs = std::filesystem;
 constexpr double kWaitSeconds = 200.0;  // wall time for the bag to play and settle
 constexpr double kQuietSeconds = 6.0;   // no counter moved for this long: the bag has ended
 constexpr double kMinFreeShare = 0.95;  // of the offline map's free cells, free to both rules
-constexpr double kResetSeconds = 1.0;   // ~reset to the reset map, wall time
-constexpr double kLateSeconds = 3.0;    // a late subscriber's first message, wall time
+constexpr double kResetSeconds = 30.0;  // bound on ~reset's reset map, wall time (not a latency)
+constexpr double kLateSeconds = 30.0;   // bound on a late subscriber's first message, wall time
+constexpr double kFlushSeconds = 60.0;  // bound on the wait for ~flush's layers, wall time
 
 /// How the two consumers read one value.
 enum class Reading { kFree, kOccupied, kUnknown };
@@ -96,6 +100,12 @@ class Grids {
     std::lock_guard<std::mutex> lock(mutex_);
     return maps_;
   }
+  /// Messages received on a layer's topic (scale 0: `map`).
+  std::size_t received(int scale) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = received_.find(scale);
+    return it == received_.end() ? 0 : it->second;
+  }
   std::size_t updates() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return updates_;
@@ -127,6 +137,7 @@ class Grids {
       }
     }
     last_[scale] = m;
+    ++received_[scale];
   }
   void onUpdate(const map_msgs::OccupancyGridUpdate::ConstPtr& u) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -149,6 +160,7 @@ class Grids {
 
   mutable std::mutex mutex_;
   std::map<int, nav_msgs::OccupancyGrid::ConstPtr> last_;
+  std::map<int, std::size_t> received_;
   std::set<int> values_;
   std::size_t maps_ = 0, updates_ = 0, outside_ = 0, boxes_ = 0;
   std::vector<ros::Subscriber> subs_;
@@ -156,10 +168,17 @@ class Grids {
 
 std::mutex g_mutex;
 wavog_mapping::MapperStatus::ConstPtr g_status;
+std::size_t g_statuses = 0;  // ~status messages received
 
 void onStatus(const wavog_mapping::MapperStatus::ConstPtr& s) {
   std::lock_guard<std::mutex> lock(g_mutex);
   g_status = s;
+  ++g_statuses;
+}
+
+std::size_t statuses() {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  return g_statuses;
 }
 
 /// Scans of the bag on the YAML's input topics.
@@ -273,8 +292,40 @@ TEST(Consumers, NavigationStackReadsThePublishedMap) {
   // The end of the input: every layer once more, now.
   ros::ServiceClient flush = nh.serviceClient<std_srvs::Trigger>("/wavog_mapping/flush");
   std_srvs::Trigger trigger;
+  std::vector<int> layers{0};
+  layers.insert(layers.end(), scales.begin(), scales.end());
+  std::map<int, std::size_t> before;
+  for (int s : layers) before[s] = grids.received(s);
+  const std::size_t statuses_before = statuses();
   ASSERT_TRUE(flush.call(trigger));
-  ros::WallDuration(1.0).sleep();
+  // Every layer and the status published by the flush have arrived (however long a busy machine
+  // takes).
+  const ros::WallTime flush_deadline = ros::WallTime::now() + ros::WallDuration(kFlushSeconds);
+  const auto flushed = [&] {
+    return statuses() > statuses_before && std::all_of(layers.begin(), layers.end(), [&](int s) {
+             return grids.received(s) > before[s];
+           });
+  };
+  while (!flushed() && ros::WallTime::now() < flush_deadline) ros::WallDuration(0.05).sleep();
+  ASSERT_TRUE(flushed()) << "the layers and status of ~flush did not arrive within "
+                         << kFlushSeconds << " s";
+  // The node placed the scans as wavog_offline did, however busy the host: as many integrated,
+  // as many without motion compensation (those waiting for tf when the bag ended included).
+  std::ifstream summary_file(dir / "offline" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  std::uint64_t integrated = 0, fallbacks = 0;
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    for (const auto& in : g_status->inputs) {
+      std::cout << in.topic << ": " << in.received << " received, " << in.integrated
+                << " integrated (" << in.integrated_latest_tf << " by the latest tf, "
+                << in.motion_fallbacks << " without motion compensation), " << in.lost << " lost\n";
+      integrated += in.integrated;
+      fallbacks += in.motion_fallbacks;
+    }
+  }
+  EXPECT_EQ(integrated, summary["scans_integrated"].get<std::uint64_t>());
+  EXPECT_EQ(fallbacks, summary["motion_fallbacks"].get<std::uint64_t>());
 
   const std::set<int> values = grids.values();
   std::string seen_values;
