@@ -74,14 +74,16 @@ class ScanClassifier {
   CellMasks classifyGroup(std::int64_t ix0, std::int64_t iy0, const SquareInfo& square) const;
 
   /// classifyCell() for the 64 cells of the 8 x 8 square at (ix0, iy0) classified as `square`
-  /// (fewSectors(square)), by row runs (scan_classifier_tile_inl.h).
-  TileMasks classifyTile(std::int64_t ix0, std::int64_t iy0, const SquareInfo& square) const;
+  /// (fewSectors(square)), by row runs (scan_classifier_tile_inl.h), into *out; false (out
+  /// untouched) when more than kTileMaxBoundaries boundaries would have to be located.
+  bool classifyTile(std::int64_t ix0, std::int64_t iy0, const SquareInfo& square,
+                    TileMasks* out) const;
 
   static constexpr int kFewSectors = 32;
-  /// classifyTileCells() takes the row runs up to this many sector boundaries in the tile, else the
-  /// cells one by one: a boundary costs about 70 instructions for the tile's 8 rows, a cell about
-  /// 40 (callgrind, fr079 at 5 cm: 10 and 12 both -3.8 % per scan against the row runs alone
-  /// without clearing, 10 -1.4 % with 80 m clearing; 8 and 16 less).
+  /// classifyTile() locates up to this many boundaries (between runs of sectors) in the tile, else
+  /// the cells are classified one by one: a boundary costs about 70 instructions for the tile's 8
+  /// rows, a cell about 40 (callgrind, fr079 at 5 cm: 10 and 12 both -3.8 % per scan against the
+  /// row runs alone without clearing, 10 -1.4 % with 80 m clearing; 8 and 16 less).
   static constexpr int kTileMaxBoundaries = 10;
 
  private:
@@ -98,6 +100,9 @@ class ScanClassifier {
   };
   void classifySector(int j, std::uint64_t cells, const double* a2, const double* l2,
                       const TileRange& d2, TileMasks* m) const;
+  /// A sector's cells over a tile: all E, all U, or some of each.
+  enum class SectorKind { kEmpty, kUnknown, kMixed };
+  SectorKind sectorKind(int j, const TileRange& d2) const;
   bool isHitCell(std::int64_t ix, std::int64_t iy, const SquareInfo& box) const;
   template <std::size_t kSide>
   void classifyGroups(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box,

@@ -104,7 +104,7 @@ inline TileMasks ScanClassifier::classifyTileCells(int t, std::int64_t ix0, std:
   }
   if (box.cls == CellClass::kUnknown) return m;
   if (t == 3 && fewSectors(box)) {
-    if (box.single || box.shi - box.slo <= kTileMaxBoundaries) return classifyTile(ix0, iy0, box);
+    if (classifyTile(ix0, iy0, box, &m)) return m;
     std::array<CellMasks, 4> g;  // many boundaries: cell by cell is cheaper
     classifyGroups<8>(ix0, iy0, box, g.data());
     for (unsigned q = 0; q < 4; ++q) placeGroup(g[q], 4 * (q & 1) + 32 * (q >> 1), &m);

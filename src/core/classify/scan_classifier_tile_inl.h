@@ -101,8 +101,8 @@ inline Crossings crossings(double q0, double step, double margin) {
 
 }  // namespace tile
 
-inline TileMasks ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0,
-                                              const SquareInfo& box) const {
+inline bool ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0, const SquareInfo& box,
+                                         TileMasks* out) const {
   // The reference's arithmetic for the cells' offsets and squared distances.
   const double x0 = static_cast<double>(ix0), y0 = static_cast<double>(iy0);
   std::array<double, 8> dx, dy, dx2, dy2;
@@ -127,8 +127,30 @@ inline TileMasks ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0
       *std::min_element(dx2.begin(), dx2.end()) + *std::min_element(dy2.begin(), dy2.end()),
       std::max(dx2[0], dx2[7]) + std::max(dy2[0], dy2[7])};
   TileMasks m;
-  if (box.single) {
-    classifySector(box.jlo, ~std::uint64_t{0}, dx2.data(), dy2.data(), d2r, &m);
+  // Runs of sectors: neighbours whose cells are all E over the tile (each within its beam's E
+  // limit) merge, as do those all U (beyond both limits, or outside the fan); a sector of mixed
+  // cells is a run of its own. Only the boundaries between runs are located.
+  std::array<int, kFewSectors + 1> first;  // run r: sectors first[r] .. first[r + 1] - 1
+  std::array<SectorKind, kFewSectors + 1> kind;
+  int runs = 0;
+  const int lo = box.single ? box.jlo : box.slo, hi = box.single ? box.jlo : box.shi;
+  for (int j = lo; j <= hi; ++j) {
+    const SectorKind k = sectorKind(j, d2r);
+    if (runs > 0 && k != SectorKind::kMixed && k == kind[static_cast<std::size_t>(runs - 1)]) {
+      continue;
+    }
+    first[static_cast<std::size_t>(runs)] = j;
+    kind[static_cast<std::size_t>(runs)] = k;
+    ++runs;
+  }
+  if (runs - 1 > kTileMaxBoundaries) return false;
+  const auto apply = [&](int r, std::uint64_t cells, const double* a2, const double* l2) {
+    const auto ru = static_cast<std::size_t>(r);
+    if (kind[ru] == SectorKind::kEmpty) m.e |= cells;
+    if (kind[ru] == SectorKind::kMixed) classifySector(first[ru], cells, a2, l2, d2r, &m);
+  };
+  if (runs == 1) {
+    apply(0, ~std::uint64_t{0}, dx2.data(), dy2.data());
   } else {
     // Lines are rows (cells along x) when the boundaries are nearer the y axis, else columns
     // (transposed: bit y + 8 x until the end). A boundary (bx, by) has the cells with cross
@@ -145,12 +167,11 @@ inline TileMasks ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0
                      1e-14 * (std::fabs(x0 * s_.res) + std::fabs(y0 * s_.res) + std::fabs(s_.px) +
                               std::fabs(s_.py) + 16.0 * s_.res);
     const double inv_res = 1.0 / s_.res, t_cells = t * inv_res;
-    // Boundary k: past_k, then sector k - 1's sure cells are past k - 1 and not past k.
+    // Run r + 1's first boundary: past[r]; run r's sure cells are past its own and not past[r].
     std::array<std::uint64_t, kFewSectors + 1> past;
     std::uint64_t unsure = 0;
-    const int count = box.shi - box.slo;
-    for (int i = 0; i < count; ++i) {
-      const auto k = static_cast<std::size_t>(box.slo + 1 + i);
+    for (int i = 0; i + 1 < runs; ++i) {
+      const auto k = static_cast<std::size_t>(first[static_cast<std::size_t>(i + 1)]);
       // Rows: cross = bx (v0 + line res) - by (u0 + q res); columns: by and bx swap roles and
       // the product changes sign.
       const double a = rows ? s_.bnd_y[k] : s_.bnd_x[k], b = rows ? s_.bnd_x[k] : s_.bnd_y[k];
@@ -165,12 +186,12 @@ inline TileMasks ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0
     const double* l2 = rows ? dy2.data() : dx2.data();  // by line
     const double* c2 = rows ? dx2.data() : dy2.data();  // along it
     std::uint64_t past_prev = ~unsure;
-    for (int i = 0; i < count; ++i) {
+    for (int i = 0; i + 1 < runs; ++i) {
       const std::uint64_t p = past[static_cast<std::size_t>(i)];
-      classifySector(box.slo + i, past_prev & ~p, c2, l2, d2r, &m);
+      apply(i, past_prev & ~p, c2, l2);
       past_prev = p & ~unsure;
     }
-    classifySector(box.shi, past_prev, c2, l2, d2r, &m);
+    apply(runs - 1, past_prev, c2, l2);
     if (!rows) {
       m.e = tile::transpose(m.e);
       m.o = tile::transpose(m.o);
@@ -189,9 +210,18 @@ inline TileMasks ScanClassifier::classifyTile(std::int64_t ix0, std::int64_t iy0
       if (cls == CellClass::kOccupied) m.o |= one;
     }
   }
-  m.e &= ~hit;
-  m.o = (m.o & ~m.e) | hit;
-  return m;
+  out->e = m.e & ~hit;
+  out->o = (m.o & ~out->e) | hit;
+  return true;
+}
+
+/// How sector j's cells of a tile whose squared distances lie in d2r compare with its limits.
+inline ScanClassifier::SectorKind ScanClassifier::sectorKind(int j, const TileRange& d2r) const {
+  if (j < 0 || j >= s_.n) return SectorKind::kUnknown;
+  const LeafTest& t = s_.leaf[static_cast<std::size_t>(j)];
+  if (d2r.hi < t.e) return SectorKind::kEmpty;
+  if (d2r.lo >= t.e && d2r.lo > t.o) return SectorKind::kUnknown;
+  return SectorKind::kMixed;
 }
 
 /// Sector j's cells `cells` of a tile (bit along + 8 line; squared offsets along the line a2 and
