@@ -107,6 +107,7 @@ void MappingRos::Impl::diagnoseMapper(diagnostic_updater::DiagnosticStatusWrappe
   const wavog::MapStats ms = map_.stats();
   stat.add("blocks", ms.blocks);
   stat.add("nodes", ms.nodes);
+  stat.add("tiles", ms.tiles);
   stat.add("bytes", ms.bytes);
 }
 

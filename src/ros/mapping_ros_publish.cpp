@@ -142,6 +142,7 @@ wavog_mapping::MapperStatus::Ptr MappingRos::Impl::statusLocked(const ros::Time&
   const wavog::MapStats ms = map_.stats();
   status->blocks = ms.blocks;
   status->nodes = ms.nodes;
+  status->tiles = ms.tiles;
   status->bytes = ms.bytes;
   return status;
 }

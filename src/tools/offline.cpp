@@ -304,6 +304,7 @@ Json summaryOf(const Options& o, const wavog_ros::Config& config, const InputInf
                                                          : 0.0;
   summary["map"] = {{"blocks", stats.blocks},
                     {"nodes", stats.nodes},
+                    {"tiles", stats.tiles},
                     {"bytes", stats.bytes},
                     {"observed_cells", stats.observed_cells},
                     {"bytes_per_observed_cell", bytesPerCell(stats)}};

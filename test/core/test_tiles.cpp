@@ -32,12 +32,16 @@ TEST(Tiles, PolicyChangesConvertTilesAndKeepEveryCell) {
   RandomScans scans(7, 2.5);
   integrateScans(&scans, 60, changed, kept);
   ASSERT_GT(changed.stats().nodes, 100u);
+  const std::size_t tiles = changed.stats().tiles;
+  ASSERT_GT(tiles, 10u);
+  EXPECT_LT(tiles, changed.stats().nodes);
   const std::size_t float_bytes = changed.stats().bytes;
   const MapParams wide = tileParams(PolicyType::kClampLower);
   changed.setPolicy(wide.policy, wide.sensor);
   expectSameCells(changed, kept, kHalf, 0.0);
   const std::size_t wide_bytes = changed.stats().bytes;
   EXPECT_GT(wide_bytes, float_bytes + float_bytes / 4) << "double tiles take more room";
+  EXPECT_EQ(changed.stats().tiles, tiles) << "converted, not dropped or added";
   changed.setPolicy(kept.params().policy, kept.params().sensor);
   expectSameCells(changed, kept, kHalf, 0.0);
   EXPECT_LT(changed.stats().bytes, wide_bytes);
@@ -61,6 +65,7 @@ TEST(Tiles, FilesLoadIntoMapsOfTheOtherKind) {
       // A double tile's values rounded to float (and back) on loading into a float map.
       const bool rounded = saved == &wide && type == PolicyType::kClamp;
       expectSameCells(loaded, *saved, kHalf, rounded ? 1e-6 : 0.0);
+      EXPECT_EQ(loaded.stats().tiles, saved->stats().tiles);
     }
   }
   std::remove(path.c_str());

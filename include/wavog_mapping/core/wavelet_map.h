@@ -50,6 +50,7 @@ struct IntegrateStats {
 struct MapStats {
   std::size_t blocks = 0;            ///< hashed blocks
   std::size_t nodes = 0;             ///< live quadtree nodes (each holds 3 details)
+  std::size_t tiles = 0;             ///< dense 8 x 8 leaf tiles (storage/tile.h), of `nodes`
   std::size_t bytes = 0;             ///< bytes used: blocks, live node groups and the hash
   std::size_t reflection_bytes = 0;  ///< of them, the reflection layers' (MapParams::reflection)
   std::size_t ndt_cells = 0;         ///< finest cells holding a Gaussian (MapParams::ndt)

@@ -32,6 +32,7 @@ MapStats WaveletMap::stats(bool count_observed) const {
   MapStats st;
   st.blocks = impl.blocks.size();
   st.nodes = impl.counts.nodes;
+  st.tiles = impl.counts.tiles;
   // Hash: one heap node per block (key, Block, next pointer, cached hash) plus the bucket array.
   const std::size_t per_block = sizeof(std::uint64_t) + sizeof(Block) + 2 * sizeof(void*);
   // The blocks' spare node groups are chained in the pool's chunks (bytes_reserved).
