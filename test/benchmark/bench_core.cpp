@@ -247,20 +247,30 @@ void printSummary() {
                 kv.second.visited_per_scan, kv.second.bytes_per_cell);
   }
   auto m = [](const std::string& k) { return median(g_rates[k]); };
+  // A ratio of two variants, only when the run measured both (a --benchmark_filter may leave one
+  // out).
+  auto both = [](const std::string& a, const std::string& b) {
+    return g_rates.count(a) > 0 && g_rates.count(b) > 0;
+  };
   std::printf("\n== Targets ==\n");
   for (const char* wl : {"fr079", "synthetic80m"}) {
     for (const char* res : {"5cm", "10cm"}) {
       const std::string base = std::string(wl) + "@" + res + "/";
-      if (!g_rates.count(base + "clamp")) continue;
-      std::printf("%-20s forget_lazy cost / clamp cost = %.2f (target <= 1.1)\n", (std::string(wl) + "@" + res).c_str(),
-                  m(base + "clamp") / m(base + "forget_lazy"));
-      std::printf("%-20s lazy / eager speed           = %.2f (target >= 3 on 80 m)\n", (std::string(wl) + "@" + res).c_str(),
-                  m(base + "forget_lazy") / m(base + "forget_eager"));
+      if (both(base + "clamp", base + "forget_lazy")) {
+        std::printf("%-20s forget_lazy cost / clamp cost = %.2f (target <= 1.1)\n",
+                    (std::string(wl) + "@" + res).c_str(),
+                    m(base + "clamp") / m(base + "forget_lazy"));
+      }
+      if (both(base + "forget_lazy", base + "forget_eager")) {
+        std::printf("%-20s lazy / eager speed           = %.2f (target >= 3 on 80 m)\n",
+                    (std::string(wl) + "@" + res).c_str(),
+                    m(base + "forget_lazy") / m(base + "forget_eager"));
+      }
       for (const char* payload : {"reflection", "ndt"}) {
         const double target = std::string(payload) == "ndt" ? 1.5 : 1.3;
         for (const char* v : {"clamp", "forget_lazy"}) {
           const std::string with = base + v + "+" + payload;
-          if (!g_rates.count(with)) continue;
+          if (!both(base + v, with)) continue;
           std::printf("%-20s %-11s %-10s cost / occupancy alone = %.2f (target <= %.1f), "
                       "bytes/cell %.3f -> %.3f\n",
                       (std::string(wl) + "@" + res).c_str(), v, payload, m(base + v) / m(with),
