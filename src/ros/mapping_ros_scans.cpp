@@ -333,6 +333,20 @@ std::size_t MappingRos::Impl::releaseReadyLocked(Input* in) {
       dropLocked(in, DropReason::kTfUnavailable, laterScansPlacedText());
       continue;
     }
+    // tf covers its stamp + tf_tolerance but not its stamp: the stamp lies before the oldest
+    // transform of its frame (a scan stamped just before the first tf), which tf never covers.
+    // The filter keeps such a scan until newer ones push it out, and those pass straight through:
+    // it held up its input until the end (wavog_offline drops it as tf_extrapolation).
+    const std_msgs::Header& h = front.scan->header;
+    if (!buffer_->canTransform(placement_.fixed_frame, h.frame_id, h.stamp) &&
+        buffer_->canTransform(placement_.fixed_frame, h.frame_id, h.stamp + tolerance)) {
+      p.pop_front();
+      ++n;
+      dropLocked(in, DropReason::kTfTooOld,
+                 "stamp before the oldest transform of its frame (tf covers it from less than "
+                 "tf_tolerance later on)");
+      continue;
+    }
     break;
   }
   return n;

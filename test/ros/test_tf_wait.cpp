@@ -5,6 +5,8 @@
 // newest transform of their frame more than tf_cache_time (10 s) after their stamp (tf_too_old).
 // A scan whose stamp + tf_tolerance tf covers, but not its sweep's end, waits for that tf too:
 // placed as soon as tf reached the stamp, it was compensated or not by how busy the host was.
+// A scan stamped less than tf_tolerance before its frame's first transform is dropped (it held
+// its input up until the end: fleet.test's intermittent failure).
 // Each case on its own input, so that the scans one holds back do not hold up another's.
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
@@ -104,10 +106,14 @@ TEST(TfWait, PushedOutScansWaitForTfAndStopAtTheBounds) {
   tf.sendTransform(mapTo("old", t0 - ros::Duration(5.0)));
   publishScans(pubs[2], "old", t0, 4);
   // Sweep: tf up to 0.05 s after the stamp (tf_tolerance 0.03 s), then, after the scan has
-  // passed the filter, beyond the sweep's 0.2 s.
+  // passed the filter, beyond the sweep's 0.2 s. Before it, a scan stamped 0.02 s before the
+  // frame's first transform: tf covers its stamp + tf_tolerance, never its stamp; it must be
+  // dropped, not hold the input up.
   tf.sendTransform(std::vector<geometry_msgs::TransformStamped>{
       mapTo("sweep", t0 - ros::Duration(1.0)), mapTo("sweep", t0 + ros::Duration(0.05))});
   ros::WallDuration(0.2).sleep();
+  pubs[3].publish(scanAt("sweep", t0 - ros::Duration(1.02)));
+  ros::WallDuration(0.1).sleep();
   auto sweep = scanAt("sweep", t0);
   sweep->time_increment = static_cast<float>(0.2 / 199);
   pubs[3].publish(sweep);
@@ -127,6 +133,7 @@ TEST(TfWait, PushedOutScansWaitForTfAndStopAtTheBounds) {
       3, [](const wavog_mapping::InputStatus& in) { return in.integrated >= 1; }, 20.0);
   ASSERT_TRUE(swept);
   EXPECT_EQ(swept->inputs[3].motion_fallbacks, 0u) << swept->inputs[3];
+  EXPECT_EQ(swept->inputs[3].dropped_tf_too_old, 1u) << swept->inputs[3];
 
   const auto stopped = waitInput(
       1, [](const wavog_mapping::InputStatus& in) { return in.dropped_tf_unavailable >= 4; }, 20.0);
