@@ -28,6 +28,7 @@ if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/mapping_ros.cpp)
     src/ros/reconfigure.cpp
     src/ros/mapping_ros.cpp
     src/ros/mapping_ros_scans.cpp
+    src/ros/mapping_ros_tf_wait.cpp
     src/ros/mapping_ros_publish.cpp
     src/ros/mapping_ros_diagnostics.cpp
     src/ros/mapping_ros_services.cpp

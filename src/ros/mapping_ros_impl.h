@@ -1,6 +1,7 @@
 // MappingRos::Impl: the state of the mapper and which lock guards what. Its methods are split by
 // role: mapping_ros.cpp (construction: inputs, tf, publishers, services, reconfigure, timers),
-// mapping_ros_scans.cpp (one scan, from the callback to the core call), mapping_ros_publish.cpp
+// mapping_ros_scans.cpp (one scan, from the callback to the core call), mapping_ros_tf_wait.cpp
+// (scans waiting for tf, released in the order received), mapping_ros_publish.cpp
 // (timers: layers, map_updates, ~status), mapping_ros_diagnostics.cpp (/diagnostics),
 // mapping_ros_services.cpp (~reset, ~clear_region, ~save_map, ~flush, dynamic_map),
 // mapping_ros_flush.cpp (the end of the input: scans still waiting for tf, the last publication).
@@ -138,20 +139,22 @@ struct MappingRos::Impl {
   void onFilterFailure(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan,
                        tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onTransformable(Input* in, const sensor_msgs::LaserScan::ConstPtr& scan);
+  // ---- scans waiting for tf (mapping_ros_tf_wait.cpp)
   /// The entry of `scan` in in->pending; null if it is not there (flushed or already handled).
   PendingScan* findPendingLocked(Input* in, const sensor_msgs::LaserScan* scan);
   /// Integrates (or drops) the placed scans at the front of in->pending, in the order received,
   /// up to the first one still waiting for tf; a scan pushed out of the filter at the front is
   /// placed here once tf covers it. Returns how many left the queue.
   std::size_t releaseReadyLocked(Input* in);
-  /// Why the scan at the front of in->pending, pushed out of the filter and not yet placeable,
-  /// must be dropped now (`reason` set), or empty: it goes on waiting for tf.
   /// The drop message of a scan tf cannot place while more than queue_size later ones are placed.
   std::string laterScansPlacedText() const;
+  /// Why the scan at the front of in->pending, waiting outside the filter and not yet placeable,
+  /// must be dropped now (`reason` set), or empty: it goes on waiting for tf.
   std::string outsideDropLocked(Input* in, DropReason* reason);
   /// Wall timer (retry_timer_): places the scans pushed out of the filter that tf now covers,
   /// when no other scan of their input comes to do it (the end of a bag, tf in one late burst).
   void onRetryTimer(const ros::WallTimerEvent&);
+  // ---- one scan, continued (mapping_ros_scans.cpp)
   /// A scan tf has placed (or failed to): dropped, or integrated with its placement.
   void integratePlacedScanLocked(Input* in, const sensor_msgs::LaserScan& scan,
                                  const ScanPlacement& placement);
