@@ -344,7 +344,9 @@ TEST(Limits, WideBandKeepsTheWorkOfAScanBounded) {
       const double inc = f.fov / static_cast<double>(f.beams);
       const double hard = wavog::hardRangeLimit(p, f.beams, inc);
       EXPECT_LE(hard, wavog::hardRangeLimit(p.grid, f.beams));
-      if (band == 0.0) EXPECT_EQ(hard, wavog::hardRangeLimit(p.grid, f.beams));
+      if (band == 0.0) {
+        EXPECT_EQ(hard, wavog::hardRangeLimit(p.grid, f.beams));
+      }
       const std::vector<float> ranges(f.beams, static_cast<float>(0.999 * hard));
       WaveletMap map(p);
       const ScanView scan{ranges.data(), ranges.size(), -0.5 * f.fov, inc, 0.0, kInf};

@@ -1,7 +1,8 @@
 // A tile's observed cells updated in one loop (storage/tile.h, Integrator::visitTile): the
 // policy shifted to the stored values (update_policy.h: ShiftedPolicy), every stored value kept
 // within the file bound. Float tiles (the bounded policies) go four cells an instruction in SSE2,
-// row by row, in float; double tiles (the unbounded ones) cell by cell in double. Returns the sum
+// row by row, in float (eight cells an instruction where the CPU runs AVX2); double tiles (the
+// unbounded ones) cell by cell in double. Returns the sum
 // of the changes of the stored values (in double: the tree above holds the tile's mean).
 // Not installed; included only by src/core/update/quadtree_update.h.
 #ifndef WAVOG_MAPPING_SRC_CORE_UPDATE_TILE_UPDATE_H_
@@ -15,6 +16,7 @@
 #endif
 
 #include "storage/tile.h"
+#include "update/tile_update_avx2.h"
 #include "update/update_policy.h"
 
 namespace wavog {
@@ -100,10 +102,11 @@ inline __m128d addChanges(__m128d sum, __m128 now, __m128 was) {
 
 }  // namespace tile_sse
 
-/// Float tiles: four cells an instruction; a row's unobserved cells keep their stored values.
+/// Float tiles in SSE2: four cells an instruction; a row's unobserved cells keep their stored
+/// values.
 template <PolicyType P>
-inline double updateTileCells(const ShiftedPolicy& sp, FloatTile* t, std::uint64_t e,
-                              std::uint64_t o) {
+inline double updateTileCellsSse2(const ShiftedPolicy& sp, FloatTile* t, std::uint64_t e,
+                                  std::uint64_t o) {
   using namespace tile_sse;
   const Consts c(sp);
   const std::uint64_t observed = e | o;
@@ -126,6 +129,17 @@ inline double updateTileCells(const ShiftedPolicy& sp, FloatTile* t, std::uint64
   double parts[2];
   _mm_storeu_pd(parts, sum);
   return parts[0] + parts[1];
+}
+
+/// Float tiles: a row an instruction where the CPU runs AVX2 (tile_update_avx2.h), else four
+/// cells one; the same result either way.
+template <PolicyType P>
+inline double updateTileCells(const ShiftedPolicy& sp, FloatTile* t, std::uint64_t e,
+                              std::uint64_t o) {
+#if defined(WAVOG_TILE_AVX2)
+  if (tile_avx2::available()) return tile_avx2::update<P>(sp, t, e, o);
+#endif
+  return updateTileCellsSse2<P>(sp, t, e, o);
 }
 #endif
 
