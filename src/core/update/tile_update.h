@@ -2,8 +2,8 @@
 // policy shifted to the stored values (update_policy.h: ShiftedPolicy), every stored value kept
 // within the file bound. Float tiles (the bounded policies) go four cells an instruction in SSE2,
 // row by row, in float (eight cells an instruction where the CPU runs AVX2); double tiles (the
-// unbounded ones) cell by cell in double. Returns the sum
-// of the changes of the stored values (in double: the tree above holds the tile's mean).
+// unbounded ones) cell by cell in double. Returns the sum of the changes of the stored values (in
+// double: the tree above holds the tile's mean).
 // Not installed; included only by src/core/update/quadtree_update.h.
 #ifndef WAVOG_MAPPING_SRC_CORE_UPDATE_TILE_UPDATE_H_
 #define WAVOG_MAPPING_SRC_CORE_UPDATE_TILE_UPDATE_H_
